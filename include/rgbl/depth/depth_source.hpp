@@ -1,0 +1,53 @@
+#pragma once
+// The interface between "where depth comes from" and the tracker. A DepthSource turns one frame's
+// sensor data (LiDAR scan, stereo pair, depth image, ...) into metric depth at keypoints, with what
+// the tracker needs to weight it. Strategies are created by name (see the registry in this module).
+
+#include "rgbl/geometry/calibration.hpp"
+#include "rgbl/geometry/point_cloud.hpp"
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include <cstddef>
+#include <span>
+#include <string_view>
+
+namespace rgbl {
+
+// One frame's raw sensor data, as a depth source consumes it. Views only: nothing is copied.
+struct SensorFrame {
+  std::size_t index = 0;
+  double timestamp = 0.0;     // seconds
+  cv::Mat image;              // tracked (rectified) camera image, CV_8UC1 or CV_8UC3
+  cv::Mat image_right;        // rectified right image of a stereo pair; empty if none
+  cv::Mat depth_image;        // a depth camera's or precomputed depth (CV_16UC1 or CV_32FC1); empty if none
+  PointCloudView scan;        // LiDAR scan in the LiDAR frame; empty if none
+};
+
+// Depth at one keypoint. z == 0 means "no depth here".
+struct KeypointDepth {
+  float z = 0.0F;                   // camera depth (along the optical axis), metres
+  float sample_distance_px = 0.0F;  // pixel distance to the real measurement the value came from
+  float spread = 0.0F;              // max - min of valid depths under the kernel, metres (depth edge)
+};
+
+class DepthSource {
+ public:
+  virtual ~DepthSource() = default;
+
+  virtual std::string_view name() const = 0;
+
+  // Per-frame work that does not depend on keypoints (e.g. projecting the scan). Throws on input the
+  // source cannot use (e.g. no scan for a LiDAR source), naming what was expected.
+  virtual void prepare(const SensorFrame& frame) = 0;
+
+  // Depth at keypoint pixels, after prepare(). out.size() == pixels.size().
+  virtual void sample(std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) const = 0;
+
+  // The dense (completed) depth map of the prepared frame, metres, 0 = none: for visualisation and
+  // evaluation; may be computed on demand.
+  virtual cv::Mat_<float> dense_depth() const = 0;
+};
+
+}  // namespace rgbl

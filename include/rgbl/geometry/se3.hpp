@@ -1,0 +1,34 @@
+#pragma once
+// Rigid-body transforms on Eigen. A transform is named by its frames: T_a_b maps points expressed in
+// frame b into frame a (p_a = T_a_b * p_b), so T_a_c = T_a_b * T_b_c.
+// Tangent vectors are ordered [rho (translation part); phi (rotation part)].
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace rgbl {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix34d = Eigen::Matrix<double, 3, 4>;
+
+// Skew-symmetric matrix with hat(a) * b == a.cross(b).
+Eigen::Matrix3d hat(const Eigen::Vector3d& v);
+
+Eigen::Matrix3d so3_exp(const Eigen::Vector3d& phi);
+// Rotation vector of R, angle in [0, pi]; stable near 0 and pi.
+Eigen::Vector3d so3_log(const Eigen::Matrix3d& R);
+
+Eigen::Isometry3d se3_exp(const Vector6d& xi);
+Vector6d se3_log(const Eigen::Isometry3d& T);
+
+// Geodesic interpolation: s = 0 gives T_a, s = 1 gives T_b.
+Eigen::Isometry3d interpolate(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b, double s);
+
+// Angle of a rotation in radians, in [0, pi].
+double rotation_angle(const Eigen::Matrix3d& R);
+
+Eigen::Isometry3d make_isometry(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+Eigen::Isometry3d isometry_from_3x4(const Matrix34d& M);
+Matrix34d to_3x4(const Eigen::Isometry3d& T);
+
+}  // namespace rgbl

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Installs rgbl's build dependencies from Debian 12's packages. Idempotent: installs only what is
+# missing, and does nothing (not even apt-get update) when everything is there.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libeigen3-dev                               # Eigen 3.4
+  libopencv-dev                               # OpenCV 4.6
+  libceres-dev                                # Ceres 2.1 (brings SuiteSparse)
+  libspdlog-dev libfmt-dev                    # spdlog 1.10 on the external fmt 9
+  catch2                                      # Catch2 2.13
+  libbenchmark-dev                            # Google Benchmark 1.7
+  libcli11-dev                                # CLI11
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all build dependencies are installed"
+  exit 0
+fi
+
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "install-deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  sudo_cmd=(sudo)
+fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

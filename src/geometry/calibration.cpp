@@ -1,0 +1,165 @@
+#include "rgbl/geometry/calibration.hpp"
+
+#include "rgbl/core/error.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace rgbl {
+namespace {
+
+struct Entry {
+  std::vector<double> values;
+  std::size_t line = 0;
+};
+
+// "KEY: v1 v2 ..." lines. Lines whose values are not all numbers (e.g. raw's calib_time) are kept with
+// an empty value list so that asking for them gives a precise message.
+struct KeyValueFile {
+  std::filesystem::path path;
+  std::map<std::string, Entry, std::less<>> entries;
+
+  const Entry& get(const std::string& key, std::size_t count) const {
+    const auto it = entries.find(key);
+    if (it == entries.end()) {
+      throw ParseError(path, 0, fmt::format("expected a line '{}: ' followed by {} numbers", key, count));
+    }
+    if (it->second.values.size() != count) {
+      throw ParseError(path, it->second.line,
+                       fmt::format("expected {} numbers after '{}:', found {}", count, key,
+                                   it->second.values.size()));
+    }
+    return it->second;
+  }
+};
+
+bool parse_double(std::string_view token, double& out) {
+  const auto* end = token.data() + token.size();
+  const auto result = std::from_chars(token.data(), end, out);
+  return result.ec == std::errc() && result.ptr == end;
+}
+
+KeyValueFile read_key_value_file(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw ParseError(path, 0, "cannot open the file (expected a KITTI calibration file)");
+  KeyValueFile file{path, {}};
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") == std::string::npos) continue;
+    const auto colon = line.find(':');
+    if (colon == std::string::npos) {
+      throw ParseError(path, line_no, "expected 'KEY: values', found no ':'");
+    }
+    std::string key = line.substr(0, colon);
+    key.erase(0, key.find_first_not_of(" \t"));
+    key.erase(key.find_last_not_of(" \t") + 1);
+    Entry entry;
+    entry.line = line_no;
+    std::string_view rest(line);
+    rest.remove_prefix(colon + 1);
+    bool numeric = true;
+    while (!rest.empty()) {
+      const auto start = rest.find_first_not_of(" \t");
+      if (start == std::string_view::npos) break;
+      rest.remove_prefix(start);
+      const auto stop = std::min(rest.find_first_of(" \t"), rest.size());
+      double value = 0.0;
+      if (!parse_double(rest.substr(0, stop), value)) {
+        numeric = false;
+        break;
+      }
+      entry.values.push_back(value);
+      rest.remove_prefix(stop);
+    }
+    if (!numeric) entry.values.clear();
+    file.entries.insert_or_assign(std::move(key), std::move(entry));
+  }
+  return file;
+}
+
+template <int Rows, int Cols>
+Eigen::Matrix<double, Rows, Cols> row_major(const std::vector<double>& v) {
+  Eigen::Matrix<double, Rows, Cols> m;
+  for (int r = 0; r < Rows; ++r)
+    for (int c = 0; c < Cols; ++c) m(r, c) = v[static_cast<std::size_t>(r * Cols + c)];
+  return m;
+}
+
+void check_projection(const KeyValueFile& file, const std::string& key, const Matrix34d& P) {
+  if (!(P(0, 0) > 0.0 && P(1, 1) > 0.0 && P(2, 2) > 0.0)) {
+    throw ParseError(file.path, file.entries.find(key)->second.line,
+                     fmt::format("expected '{}' to be a projection K[I|t] with positive focal lengths", key));
+  }
+}
+
+}  // namespace
+
+Matrix34d CameraCalibration::P_img_lidar() const {
+  return camera.K() * T_cam_lidar.matrix().topRows<3>();
+}
+
+CameraCalibration KittiCalibration::camera(int index) const {
+  if (index < 0 || index > 3) throw ConfigError("camera", "a KITTI camera index 0..3");
+  const Matrix34d& Pi = P[static_cast<std::size_t>(index)];
+  CameraCalibration c;
+  c.camera.fx = Pi(0, 0);
+  c.camera.fy = Pi(1, 1);
+  c.camera.cx = Pi(0, 2);
+  c.camera.cy = Pi(1, 2);
+  c.camera.width = width[static_cast<std::size_t>(index)];
+  c.camera.height = height[static_cast<std::size_t>(index)];
+  // P_i = K [I | t_i]  =>  t_i = K^-1 * P_i.col(3): the camera's offset from rectified cam0.
+  const Eigen::Matrix3d K = Pi.leftCols<3>();
+  c.T_cam_cam0 = make_isometry(Eigen::Matrix3d::Identity(), K.inverse() * Pi.col(3));
+  c.T_cam_lidar = c.T_cam_cam0 * T_cam0_lidar;
+  return c;
+}
+
+double KittiCalibration::baseline(int a, int b) const {
+  return (camera(a).T_cam_cam0.translation() - camera(b).T_cam_cam0.translation()).norm();
+}
+
+KittiCalibration read_kitti_odometry_calibration(const std::filesystem::path& calib_txt, int width,
+                                                 int height) {
+  const KeyValueFile file = read_key_value_file(calib_txt);
+  KittiCalibration calib;
+  for (int i = 0; i < 4; ++i) {
+    const std::string key = fmt::format("P{}", i);
+    calib.P[static_cast<std::size_t>(i)] = row_major<3, 4>(file.get(key, 12).values);
+    check_projection(file, key, calib.P[static_cast<std::size_t>(i)]);
+  }
+  calib.T_cam0_lidar = isometry_from_3x4(row_major<3, 4>(file.get("Tr", 12).values));
+  calib.width.fill(width);
+  calib.height.fill(height);
+  return calib;
+}
+
+KittiCalibration read_kitti_raw_calibration(const std::filesystem::path& date_dir) {
+  const KeyValueFile cam = read_key_value_file(date_dir / "calib_cam_to_cam.txt");
+  const KeyValueFile velo = read_key_value_file(date_dir / "calib_velo_to_cam.txt");
+  KittiCalibration calib;
+  for (int i = 0; i < 4; ++i) {
+    const auto idx = static_cast<std::size_t>(i);
+    const std::string p_key = fmt::format("P_rect_0{}", i);
+    calib.P[idx] = row_major<3, 4>(cam.get(p_key, 12).values);
+    check_projection(cam, p_key, calib.P[idx]);
+    const auto& size = cam.get(fmt::format("S_rect_0{}", i), 2).values;
+    calib.width[idx] = static_cast<int>(size[0]);
+    calib.height[idx] = static_cast<int>(size[1]);
+  }
+  const Eigen::Matrix3d R_rect = row_major<3, 3>(cam.get("R_rect_00", 9).values);
+  const Eigen::Matrix3d R = row_major<3, 3>(velo.get("R", 9).values);
+  const Eigen::Vector3d t = row_major<3, 1>(velo.get("T", 3).values);
+  calib.T_cam0_lidar = make_isometry(R_rect, Eigen::Vector3d::Zero()) * make_isometry(R, t);
+  return calib;
+}
+
+}  // namespace rgbl

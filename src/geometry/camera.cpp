@@ -1,0 +1,68 @@
+#include "rgbl/geometry/camera.hpp"
+
+#include "rgbl/core/error.hpp"
+
+#include <Eigen/LU>
+
+namespace rgbl {
+
+void PinholeCamera::validate() const {
+  require(fx > 0.0 && fy > 0.0, "camera.fx/fy", "focal lengths > 0");
+  require(width > 0 && height > 0, "camera.width/height", "an image size > 0");
+}
+
+Eigen::Matrix3d PinholeCamera::K() const {
+  Eigen::Matrix3d k;
+  k << fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0;
+  return k;
+}
+
+Eigen::Vector2d PinholeCamera::project_unchecked(const Eigen::Vector3d& p_cam) const {
+  Eigen::Vector2d xn(p_cam.x() / p_cam.z(), p_cam.y() / p_cam.z());
+  if (!distortion.is_zero()) xn = distort(xn);
+  return {fx * xn.x() + cx, fy * xn.y() + cy};
+}
+
+std::optional<Eigen::Vector2d> PinholeCamera::project(const Eigen::Vector3d& p_cam) const {
+  if (!(p_cam.z() > 0.0)) return std::nullopt;
+  const Eigen::Vector2d px = project_unchecked(p_cam);
+  if (!in_image(px)) return std::nullopt;
+  return px;
+}
+
+Eigen::Vector3d PinholeCamera::unproject(const Eigen::Vector2d& px, double z) const {
+  Eigen::Vector2d xn((px.x() - cx) / fx, (px.y() - cy) / fy);
+  if (!distortion.is_zero()) xn = undistort(xn);
+  return {xn.x() * z, xn.y() * z, z};
+}
+
+Eigen::Vector2d PinholeCamera::distort(const Eigen::Vector2d& xn) const {
+  const auto& d = distortion;
+  const double x = xn.x(), y = xn.y();
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+  return {x * radial + 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x),
+          y * radial + d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y};
+}
+
+Eigen::Vector2d PinholeCamera::undistort(const Eigen::Vector2d& xd) const {
+  const auto& d = distortion;
+  Eigen::Vector2d x = xd;  // distortion is a small perturbation: the distorted point is a good start
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    const Eigen::Vector2d residual = distort(x) - xd;
+    if (residual.squaredNorm() < 1e-26) break;
+    const double u = x.x(), v = x.y();
+    const double r2 = u * u + v * v;
+    const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+    const double dradial_dr2 = d.k1 + r2 * (2.0 * d.k2 + 3.0 * r2 * d.k3);
+    Eigen::Matrix2d J;
+    J(0, 0) = radial + 2.0 * u * u * dradial_dr2 + 2.0 * d.p1 * v + 6.0 * d.p2 * u;
+    J(0, 1) = 2.0 * u * v * dradial_dr2 + 2.0 * d.p1 * u + 2.0 * d.p2 * v;
+    J(1, 0) = 2.0 * u * v * dradial_dr2 + 2.0 * d.p1 * u + 2.0 * d.p2 * v;
+    J(1, 1) = radial + 2.0 * v * v * dradial_dr2 + 6.0 * d.p1 * v + 2.0 * d.p2 * u;
+    x -= J.inverse() * residual;
+  }
+  return x;
+}
+
+}  // namespace rgbl
