@@ -13,6 +13,10 @@ packages=(
   libbenchmark-dev                            # Google Benchmark 1.7
   libcli11-dev                                # CLI11
 )
+# fuzzing (scripts/fuzz.sh) needs clang with its libFuzzer/sanitizer runtimes
+if [ "${RGBL_FUZZ:-0}" = "1" ]; then
+  packages+=(clang-14 libclang-rt-14-dev)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

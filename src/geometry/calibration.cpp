@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <string>
@@ -24,6 +25,7 @@ struct KeyValueFile {
   std::filesystem::path path;
   std::map<std::string, Entry, std::less<>> entries;
 
+  // The values of `key`, which must be `count` finite numbers.
   const Entry& get(const std::string& key, std::size_t count) const {
     const auto it = entries.find(key);
     if (it == entries.end()) {
@@ -33,6 +35,11 @@ struct KeyValueFile {
       throw ParseError(path, it->second.line,
                        fmt::format("expected {} numbers after '{}:', found {}", count, key,
                                    it->second.values.size()));
+    }
+    for (const double v : it->second.values) {
+      if (!std::isfinite(v)) {
+        throw ParseError(path, it->second.line, fmt::format("expected finite numbers after '{}:'", key));
+      }
     }
     return it->second;
   }
@@ -44,9 +51,7 @@ bool parse_double(std::string_view token, double& out) {
   return result.ec == std::errc() && result.ptr == end;
 }
 
-KeyValueFile read_key_value_file(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw ParseError(path, 0, "cannot open the file (expected a KITTI calibration file)");
+KeyValueFile parse_key_value(std::istream& in, const std::filesystem::path& path) {
   KeyValueFile file{path, {}};
   std::string line;
   std::size_t line_no = 0;
@@ -83,6 +88,12 @@ KeyValueFile read_key_value_file(const std::filesystem::path& path) {
     file.entries.insert_or_assign(std::move(key), std::move(entry));
   }
   return file;
+}
+
+std::ifstream open_calibration(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw ParseError(path, 0, "cannot open the file (expected a KITTI calibration file)");
+  return in;
 }
 
 template <int Rows, int Cols>
@@ -129,7 +140,13 @@ double KittiCalibration::baseline(int a, int b) const {
 
 KittiCalibration read_kitti_odometry_calibration(const std::filesystem::path& calib_txt, int width,
                                                  int height) {
-  const KeyValueFile file = read_key_value_file(calib_txt);
+  std::ifstream in = open_calibration(calib_txt);
+  return parse_kitti_odometry_calibration(in, calib_txt, width, height);
+}
+
+KittiCalibration parse_kitti_odometry_calibration(std::istream& in, const std::filesystem::path& source,
+                                                  int width, int height) {
+  const KeyValueFile file = parse_key_value(in, source);
   KittiCalibration calib;
   for (int i = 0; i < 4; ++i) {
     const std::string key = fmt::format("P{}", i);
@@ -143,17 +160,30 @@ KittiCalibration read_kitti_odometry_calibration(const std::filesystem::path& ca
 }
 
 KittiCalibration read_kitti_raw_calibration(const std::filesystem::path& date_dir) {
-  const KeyValueFile cam = read_key_value_file(date_dir / "calib_cam_to_cam.txt");
-  const KeyValueFile velo = read_key_value_file(date_dir / "calib_velo_to_cam.txt");
+  const auto cam_path = date_dir / "calib_cam_to_cam.txt";
+  const auto velo_path = date_dir / "calib_velo_to_cam.txt";
+  std::ifstream cam_in = open_calibration(cam_path);
+  std::ifstream velo_in = open_calibration(velo_path);
+  return parse_kitti_raw_calibration(cam_in, cam_path, velo_in, velo_path);
+}
+
+KittiCalibration parse_kitti_raw_calibration(std::istream& cam_to_cam, const std::filesystem::path& cam_source,
+                                             std::istream& velo_to_cam, const std::filesystem::path& velo_source) {
+  const KeyValueFile cam = parse_key_value(cam_to_cam, cam_source);
+  const KeyValueFile velo = parse_key_value(velo_to_cam, velo_source);
   KittiCalibration calib;
   for (int i = 0; i < 4; ++i) {
     const auto idx = static_cast<std::size_t>(i);
     const std::string p_key = fmt::format("P_rect_0{}", i);
     calib.P[idx] = row_major<3, 4>(cam.get(p_key, 12).values);
     check_projection(cam, p_key, calib.P[idx]);
-    const auto& size = cam.get(fmt::format("S_rect_0{}", i), 2).values;
-    calib.width[idx] = static_cast<int>(size[0]);
-    calib.height[idx] = static_cast<int>(size[1]);
+    const std::string s_key = fmt::format("S_rect_0{}", i);
+    const auto& size = cam.get(s_key, 2);
+    if (!(size.values[0] >= 1.0 && size.values[0] <= 1e5 && size.values[1] >= 1.0 && size.values[1] <= 1e5)) {
+      throw ParseError(cam.path, size.line, fmt::format("expected '{}' to be an image size (width height)", s_key));
+    }
+    calib.width[idx] = static_cast<int>(size.values[0]);
+    calib.height[idx] = static_cast<int>(size.values[1]);
   }
   const Eigen::Matrix3d R_rect = row_major<3, 3>(cam.get("R_rect_00", 9).values);
   const Eigen::Matrix3d R = row_major<3, 3>(velo.get("R", 9).values);

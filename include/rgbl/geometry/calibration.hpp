@@ -11,6 +11,7 @@
 
 #include <array>
 #include <filesystem>
+#include <iosfwd>
 
 namespace rgbl {
 
@@ -45,5 +46,11 @@ KittiCalibration read_kitti_odometry_calibration(const std::filesystem::path& ca
 // Reads a raw drive's calibration from the date folder holding calib_cam_to_cam.txt and
 // calib_velo_to_cam.txt. Image sizes come from S_rect_0i.
 KittiCalibration read_kitti_raw_calibration(const std::filesystem::path& date_dir);
+
+// The same parsers over streams; `source` names the input in error messages.
+KittiCalibration parse_kitti_odometry_calibration(std::istream& in, const std::filesystem::path& source,
+                                                  int width = 0, int height = 0);
+KittiCalibration parse_kitti_raw_calibration(std::istream& cam_to_cam, const std::filesystem::path& cam_source,
+                                             std::istream& velo_to_cam, const std::filesystem::path& velo_source);
 
 }  // namespace rgbl
