@@ -1,13 +1,20 @@
 // rgbl_orb_quality [<kitti-sequence-dir> [<pairs>] [<poses.txt>]]
 // Feature quality on consecutive frame pairs of a KITTI odometry sequence (default: seq 04 under
 // ../shared/data, 50 pairs of image_0): rgbl's ORB extractor against cv::ORB with the same feature
-// count, both matched by the same brute-force matcher (ratio 0.8, cross check). A match "agrees with
-// the true motion" when its Sampson distance to the epipolar geometry of the ground-truth relative
-// pose is below 1 px; a fundamental-matrix RANSAC (1 px, 0.999) is reported as well.
+// count, both matched by the same matchers:
+//  - global: brute force over the whole frame (ratio 0.8, cross check), as for initialisation;
+//  - guided: as in tracking, every keypoint of frame a with LiDAR depth (nearest sample within 2 px
+//    of the sparse depth of the velodyne scan) is predicted into frame b with the ground-truth motion
+//    and matched by match_guided (radius 15 px x scale^level, ratio 0.8, rotation histogram).
+// A match "agrees with the true motion" when its Sampson distance to the epipolar geometry of the
+// ground-truth relative pose is below 1 px; a fundamental-matrix RANSAC (1 px, 0.999) is reported
+// for the global matches as well.
 #include "rgbl/core/timer.hpp"
 #include "rgbl/features/matcher.hpp"
 #include "rgbl/features/orb.hpp"
 #include "rgbl/geometry/calibration.hpp"
+#include "rgbl/geometry/point_cloud.hpp"
+#include "rgbl/geometry/projection.hpp"
 
 #include <Eigen/Dense>
 #include <fmt/format.h>
@@ -16,11 +23,13 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -28,13 +37,35 @@ namespace {
 
 struct Features {
   std::vector<cv::Point2f> points;
+  std::vector<rgbl::Keypoint> keypoints;
   std::vector<rgbl::Descriptor> descriptors;
+  cv::Mat_<float> depth;  // sparse LiDAR depth of the frame
 };
 
 struct Totals {
   double features = 0, matches = 0, gt_inliers = 0, ransac_inliers = 0, extract_ms = 0;
+  double guided_queries = 0, guided_matches = 0, guided_gt_inliers = 0;
   int pairs = 0;
 };
+
+// Depth of the LiDAR sample nearest to (x, y) within 2 px, or 0.
+float depth_near(const cv::Mat_<float>& depth, float x, float y) {
+  const int cx = static_cast<int>(std::lround(x)), cy = static_cast<int>(std::lround(y));
+  float best = 0.0F;
+  int best_d2 = 1 << 30;
+  for (int dy = -2; dy <= 2; ++dy) {
+    for (int dx = -2; dx <= 2; ++dx) {
+      const int u = cx + dx, v = cy + dy;
+      if (u < 0 || v < 0 || u >= depth.cols || v >= depth.rows) continue;
+      const float z = depth(v, u);
+      if (z > 0.0F && dx * dx + dy * dy < best_d2) {
+        best = z;
+        best_d2 = dx * dx + dy * dy;
+      }
+    }
+  }
+  return best;
+}
 
 std::vector<Eigen::Isometry3d> read_poses(const std::filesystem::path& file) {
   std::ifstream in(file);
@@ -66,6 +97,38 @@ double sampson_px(const Eigen::Matrix3d& F, const cv::Point2f& a, const cv::Poin
   return std::abs(e) / std::sqrt(Fb.x() * Fb.x() + Fb.y() * Fb.y() + Fta.x() * Fta.x() + Fta.y() * Fta.y());
 }
 
+void accumulate_guided(Totals& t, const Features& a, const Features& b, const rgbl::PinholeCamera& camera,
+                       const Eigen::Isometry3d& T_b_a, const Eigen::Matrix3d& F, int width, int height) {
+  std::vector<rgbl::GuidedQuery> queries;
+  std::vector<int> source;
+  for (std::size_t i = 0; i < a.keypoints.size(); ++i) {
+    const auto& k = a.keypoints[i];
+    const float z = depth_near(a.depth, k.x, k.y);
+    if (z <= 0.0F) continue;
+    const Eigen::Vector3d p_b = T_b_a * camera.unproject(Eigen::Vector2d(k.x, k.y), z);
+    if (p_b.z() < 0.5) continue;
+    const Eigen::Vector2d px = camera.project_unchecked(p_b);
+    rgbl::GuidedQuery q;
+    q.x = static_cast<float>(px.x());
+    q.y = static_cast<float>(px.y());
+    q.level = k.level;
+    q.angle = k.angle;
+    q.descriptor = &a.descriptors[i];
+    queries.push_back(q);
+    source.push_back(static_cast<int>(i));
+  }
+  const rgbl::FeatureGrid grid(b.keypoints, width, height);
+  const auto result = rgbl::match_guided(queries, grid, b.keypoints, b.descriptors, rgbl::GuidedMatchOptions{});
+  t.guided_queries += static_cast<double>(queries.size());
+  for (std::size_t q = 0; q < result.size(); ++q) {
+    if (result[q] < 0) continue;
+    t.guided_matches += 1.0;
+    const auto& pa = a.points[static_cast<std::size_t>(source[q])];
+    const auto& pb = b.points[static_cast<std::size_t>(result[q])];
+    if (sampson_px(F, pa, pb) < 1.0) t.guided_gt_inliers += 1.0;
+  }
+}
+
 void accumulate(Totals& t, const Features& a, const Features& b, const Eigen::Matrix3d* F) {
   rgbl::BruteForceMatchOptions options;
   options.ratio = 0.8F;
@@ -87,12 +150,14 @@ void accumulate(Totals& t, const Features& a, const Features& b, const Eigen::Ma
   ++t.pairs;
 }
 
-void print_row(const char* name, const Totals& t, bool have_gt) {
+void print_row(const char* name, const Totals& t) {
   const double n = t.pairs;
-  fmt::print("| {:<10} | {:8.0f} | {:8.1f} | {:>22} | {:>22} | {:9.2f} |\n", name, t.features / n, t.matches / n,
-             have_gt ? fmt::format("{:.1f} ({:.1f}%)", t.gt_inliers / n, 100.0 * t.gt_inliers / t.matches) : "n/a",
+  fmt::print("| {:<8} | {:8.0f} | {:9.2f} | {:8.1f} | {:>16} | {:>16} | {:8.1f} | {:8.1f} | {:>16} |\n", name,
+             t.features / n, t.extract_ms / n, t.matches / n,
+             fmt::format("{:.1f} ({:.1f}%)", t.gt_inliers / n, 100.0 * t.gt_inliers / t.matches),
              fmt::format("{:.1f} ({:.1f}%)", t.ransac_inliers / n, 100.0 * t.ransac_inliers / t.matches),
-             t.extract_ms / (2.0 * n));
+             t.guided_queries / n, t.guided_matches / n,
+             fmt::format("{:.1f} ({:.1f}%)", t.guided_gt_inliers / n, 100.0 * t.guided_gt_inliers / t.guided_matches));
 }
 
 }  // namespace
@@ -106,51 +171,74 @@ int main(int argc, char** argv) {
     const auto calib = rgbl::read_kitti_odometry_calibration(seq / "calib.txt");
     const Eigen::Matrix3d K = calib.P[0].leftCols<3>();
     const auto poses = read_poses(poses_file);
-    const bool have_gt = static_cast<int>(poses.size()) > pairs;
+    if (static_cast<int>(poses.size()) <= pairs) throw std::runtime_error("too few poses in " + poses_file.string());
+    const rgbl::CameraCalibration cam0 = calib.camera(0);
+    rgbl::ProjectionOptions projection;
+    projection.min_depth = 1.0F;
+    std::vector<rgbl::LidarPoint> scan;
 
     cv::setNumThreads(1);
     rgbl::OrbExtractor extractor;
     auto cv_orb = cv::ORB::create(2000, 1.2F, 8);
     Totals ours, theirs;
     Features prev_ours, prev_theirs;
-    std::vector<rgbl::Keypoint> keypoints;
     std::vector<cv::KeyPoint> cv_keypoints;
     cv::Mat cv_descriptors;
     for (int frame = 0; frame <= pairs; ++frame) {
       const std::string name = fmt::format("{:06d}.png", frame);
       const cv::Mat img = cv::imread((seq / "image_0" / name).string(), cv::IMREAD_GRAYSCALE);
       if (img.empty()) throw std::runtime_error("cannot read " + (seq / "image_0" / name).string());
+      rgbl::read_kitti_scan(seq / "velodyne" / fmt::format("{:06d}.bin", frame), scan);
+      const cv::Mat_<float> depth =
+          rgbl::project_to_depth(scan, cam0.P_img_lidar(), img.cols, img.rows, projection);
       Features cur_ours, cur_theirs;
+      cur_ours.depth = depth;
+      cur_theirs.depth = depth;
       rgbl::Stopwatch watch;
-      extractor.extract(img, keypoints, cur_ours.descriptors);
-      ours.extract_ms += frame > 0 ? 2.0 * watch.lap_ms() : 0.0;
-      for (const auto& k : keypoints) cur_ours.points.emplace_back(k.x, k.y);
+      extractor.extract(img, cur_ours.keypoints, cur_ours.descriptors);
+      if (frame > 0) ours.extract_ms += watch.lap_ms();
+      for (const auto& k : cur_ours.keypoints) cur_ours.points.emplace_back(k.x, k.y);
       watch.restart();
       cv_orb->detectAndCompute(img, cv::noArray(), cv_keypoints, cv_descriptors);
-      theirs.extract_ms += frame > 0 ? 2.0 * watch.lap_ms() : 0.0;
+      if (frame > 0) theirs.extract_ms += watch.lap_ms();
       for (int i = 0; i < cv_descriptors.rows; ++i) {
+        const cv::KeyPoint& ck = cv_keypoints[static_cast<std::size_t>(i)];
         rgbl::Descriptor d{};
         std::memcpy(d.data(), cv_descriptors.ptr<std::uint8_t>(i), d.size());
         cur_theirs.descriptors.push_back(d);
-        cur_theirs.points.push_back(cv_keypoints[static_cast<std::size_t>(i)].pt);
+        cur_theirs.points.push_back(ck.pt);
+        rgbl::Keypoint k;
+        k.x = ck.pt.x;
+        k.y = ck.pt.y;
+        k.angle = ck.angle;
+        k.response = ck.response;
+        k.size = ck.size;
+        k.level = ck.octave;
+        cur_theirs.keypoints.push_back(k);
       }
       if (frame > 0) {
-        const Eigen::Matrix3d F = have_gt ? fundamental(K, poses[static_cast<std::size_t>(frame) - 1],
-                                                        poses[static_cast<std::size_t>(frame)])
-                                          : Eigen::Matrix3d::Zero();
-        accumulate(ours, prev_ours, cur_ours, have_gt ? &F : nullptr);
-        accumulate(theirs, prev_theirs, cur_theirs, have_gt ? &F : nullptr);
+        const auto& T_w_a = poses[static_cast<std::size_t>(frame) - 1];
+        const auto& T_w_b = poses[static_cast<std::size_t>(frame)];
+        const Eigen::Matrix3d F = fundamental(K, T_w_a, T_w_b);
+        const Eigen::Isometry3d T_b_a = T_w_b.inverse() * T_w_a;
+        accumulate(ours, prev_ours, cur_ours, &F);
+        accumulate(theirs, prev_theirs, cur_theirs, &F);
+        accumulate_guided(ours, prev_ours, cur_ours, cam0.camera, T_b_a, F, img.cols, img.rows);
+        accumulate_guided(theirs, prev_theirs, cur_theirs, cam0.camera, T_b_a, F, img.cols, img.rows);
       }
       prev_ours = std::move(cur_ours);
       prev_theirs = std::move(cur_theirs);
     }
-    fmt::print("{} consecutive pairs of {} (image_0), 2000 features, 8 levels, scale 1.2; brute force, ratio 0.8, "
-               "cross check; mean per pair\n\n",
+    fmt::print("{} consecutive pairs of {} (image_0), 2000 features, 8 levels, scale 1.2; mean per pair.\n"
+               "global: brute force, ratio 0.8, cross check. guided: keypoints with LiDAR depth predicted with the "
+               "ground-truth motion, match_guided defaults. agree = Sampson distance to the ground-truth epipolar "
+               "geometry < 1 px.\n\n",
                pairs, seq.string());
-    fmt::print("| extractor  | features |  matches | agree with GT motion   | F-RANSAC inliers       | ms/frame  |\n");
-    fmt::print("|------------|----------|----------|------------------------|------------------------|-----------|\n");
-    print_row("rgbl", ours, have_gt);
-    print_row("cv::ORB", theirs, have_gt);
+    fmt::print("| extractor | features | ms/frame | global matches | global agree | F-RANSAC inliers | guided queries "
+               "| guided matches | guided agree |\n");
+    fmt::print("|---|---|---|---|---|---|---|---|---|\n");
+    print_row("rgbl", ours);
+    print_row("cv::ORB", theirs);
     return 0;
   } catch (const std::exception& e) {
     fmt::print(stderr, "rgbl_orb_quality: {}\n", e.what());

@@ -20,6 +20,7 @@ void OrbOptions::validate() const {
   require(fast_min_threshold >= 1 && fast_min_threshold <= fast_threshold, "orb.fast_min_threshold",
           "in [1, fast_threshold]");
   require(cell_size >= 8, "orb.cell_size", ">= 8");
+  require(features_per_node >= 1, "orb.features_per_node", ">= 1");
   require(patch_size >= 5 && patch_size % 2 == 1, "orb.patch_size", "odd and >= 5");
   require(orientation_radius >= 1, "orb.orientation_radius", ">= 1");
   require(edge_threshold >= std::max(patch_size / 2, orientation_radius) + 1 && edge_threshold >= 4,
@@ -155,9 +156,10 @@ void OrbExtractor::detect_level(int level) {
   }
 }
 
-// Quadtree over the candidates: split nodes (breadth first) until there are `target` nodes or every
-// node holds one corner; when a full round would overshoot, split the most populated nodes first. Each
-// node then contributes its strongest corner.
+// Quadtree over the candidates: split nodes (breadth first) until there are target / per_node nodes or
+// every node holds one corner; when a full round would overshoot, split the most populated nodes
+// first. Each node then contributes its per_node strongest corners (ties: by position), and if that
+// is more than `target` the strongest of them are kept.
 void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
   selected.clear();
   if (candidates_.empty() || target <= 0) return;
@@ -166,6 +168,9 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
     selected.assign(candidates_.begin(), candidates_.end());
     return;
   }
+  // The quadtree aims at target / per_node nodes, each contributing its per_node strongest corners.
+  const int per_node = options_.features_per_node;
+  const int target_nodes = (target + per_node - 1) / per_node;
   float min_x = candidates_[0].x, max_x = min_x, min_y = candidates_[0].y, max_y = min_y;
   for (const auto& c : candidates_) {
     min_x = std::min(min_x, c.x);
@@ -222,10 +227,10 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
     }
   };
   for (;;) {
-    if (static_cast<int>(nodes_.size()) >= target) break;
+    if (static_cast<int>(nodes_.size()) >= target_nodes) break;
     const auto expandable = static_cast<int>(std::count_if(nodes_.begin(), nodes_.end(), splittable));
     if (expandable == 0) break;
-    if (static_cast<int>(nodes_.size()) + 3 * expandable < target) {
+    if (static_cast<int>(nodes_.size()) + 3 * expandable < target_nodes) {
       next_nodes_.clear();
       for (const Node& node : nodes_) {
         if (splittable(node)) {
@@ -244,7 +249,7 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
     std::size_t i = 0;
     for (; i < nodes_.size(); ++i) {
       const std::size_t total = next_nodes_.size() + (nodes_.size() - i);
-      if (static_cast<int>(total) >= target) break;
+      if (static_cast<int>(total) >= target_nodes) break;
       if (splittable(nodes_[i])) {
         split(nodes_[i], next_nodes_);
       } else {
@@ -254,18 +259,17 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
     for (; i < nodes_.size(); ++i) next_nodes_.push_back(nodes_[i]);
     nodes_.swap(next_nodes_);
   }
-  selected.reserve(nodes_.size());
+  const auto stronger = [](const Candidate& a, const Candidate& b) {
+    if (a.response != b.response) return a.response > b.response;
+    return a.y < b.y || (a.y == b.y && a.x < b.x);  // ties by position: independent of partition order
+  };
+  selected.reserve(nodes_.size() * static_cast<std::size_t>(per_node));
   for (const Node& node : nodes_) {
-    const Candidate* best = &candidates_[static_cast<std::size_t>(node.begin)];
-    for (int j = node.begin + 1; j < node.end; ++j) {
-      const Candidate& c = candidates_[static_cast<std::size_t>(j)];
-      // Ties broken by position so that the result does not depend on partition order.
-      if (c.response > best->response ||
-          (c.response == best->response && (c.y < best->y || (c.y == best->y && c.x < best->x)))) {
-        best = &c;
-      }
-    }
-    selected.push_back(*best);
+    auto* first = candidates_.data() + node.begin;
+    auto* last = candidates_.data() + node.end;
+    const int keep = std::min(per_node, node.end - node.begin);
+    std::partial_sort(first, first + keep, last, stronger);
+    selected.insert(selected.end(), first, first + keep);
   }
   if (static_cast<int>(selected.size()) > target) {
     std::stable_sort(selected.begin(), selected.end(),

@@ -30,6 +30,10 @@ struct OrbOptions {
   int fast_threshold = 12;      // per-cell threshold...
   int fast_min_threshold = 7;   // ...and the fallback for cells with no corner at fast_threshold
   int cell_size = 35;           // px at each level, for the threshold fallback
+  // The quadtree splits until it has num_features / features_per_node nodes per level budget and
+  // keeps the features_per_node strongest corners of each: 1 is ORB-SLAM's distribution; larger
+  // values trade spread for strength (see docs/features.md).
+  int features_per_node = 1;
   int edge_threshold = 19;      // keypoints keep this many px from every level border
   int patch_size = 31;          // BRIEF patch diameter; sampling points lie within patch_size / 2
   int orientation_radius = 15;  // intensity-centroid disc radius
