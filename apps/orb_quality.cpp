@@ -1,4 +1,4 @@
-// rgbl_orb_quality [<kitti-sequence-dir> [<pairs>] [<poses.txt>]]
+// rgbl_orb_quality [<kitti-sequence-dir> [<pairs> [<features_per_node>]]]
 // Feature quality on consecutive frame pairs of a KITTI odometry sequence (default: seq 04 under
 // ../shared/data, 50 pairs of image_0): rgbl's ORB extractor against cv::ORB with the same feature
 // count, both matched by the same matchers:
@@ -166,8 +166,11 @@ int main(int argc, char** argv) {
   try {
     const std::filesystem::path seq = argc > 1 ? argv[1] : "../shared/data/kitti/odometry/sequences/04";
     const int pairs = argc > 2 ? std::stoi(argv[2]) : 50;
+    rgbl::OrbOptions orb_options;
+    if (argc > 3) orb_options.features_per_node = std::stoi(argv[3]);
+    // Ground truth beside the sequences folder, as in the KITTI odometry layout.
     const std::filesystem::path poses_file =
-        argc > 3 ? std::filesystem::path(argv[3]) : seq.parent_path().parent_path() / "poses" / (seq.filename().string() + ".txt");
+        seq.parent_path().parent_path() / "poses" / (seq.filename().string() + ".txt");
     const auto calib = rgbl::read_kitti_odometry_calibration(seq / "calib.txt");
     const Eigen::Matrix3d K = calib.P[0].leftCols<3>();
     const auto poses = read_poses(poses_file);
@@ -178,7 +181,7 @@ int main(int argc, char** argv) {
     std::vector<rgbl::LidarPoint> scan;
 
     cv::setNumThreads(1);
-    rgbl::OrbExtractor extractor;
+    rgbl::OrbExtractor extractor(orb_options);
     auto cv_orb = cv::ORB::create(2000, 1.2F, 8);
     Totals ours, theirs;
     Features prev_ours, prev_theirs;
@@ -229,11 +232,12 @@ int main(int argc, char** argv) {
       prev_ours = std::move(cur_ours);
       prev_theirs = std::move(cur_theirs);
     }
-    fmt::print("{} consecutive pairs of {} (image_0), 2000 features, 8 levels, scale 1.2; mean per pair.\n"
+    fmt::print("{} consecutive pairs of {} (image_0), 2000 features, 8 levels, scale 1.2, rgbl features_per_node {}; "
+               "mean per pair.\n"
                "global: brute force, ratio 0.8, cross check. guided: keypoints with LiDAR depth predicted with the "
                "ground-truth motion, match_guided defaults. agree = Sampson distance to the ground-truth epipolar "
                "geometry < 1 px.\n\n",
-               pairs, seq.string());
+               pairs, seq.string(), orb_options.features_per_node);
     fmt::print("| extractor | features | ms/frame | global matches | global agree | F-RANSAC inliers | guided queries "
                "| guided matches | guided agree |\n");
     fmt::print("|---|---|---|---|---|---|---|---|---|\n");

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -53,7 +54,7 @@ inline int round_to_int(float v) { return static_cast<int>(v + (v >= 0.0F ? 0.5F
 
 }  // namespace
 
-std::vector<BriefPair> make_brief_pattern(int patch_size) {
+std::vector<BriefPair> make_brief_candidates(int patch_size, int count) {
   const double radius = patch_size / 2;  // integer half size: rotated, rounded points stay inside
   const double sigma = patch_size / 5.0;
   SplitMix64 rng(0x5247424C4F524231ULL);  // "RGBLORB1"
@@ -67,14 +68,27 @@ std::vector<BriefPair> make_brief_pattern(int patch_size) {
     }
   };
   std::vector<BriefPair> pattern;
-  pattern.reserve(256);
-  while (pattern.size() < 256) {
+  pattern.reserve(static_cast<std::size_t>(count));
+  while (static_cast<int>(pattern.size()) < count) {
     const auto [x1, y1] = gaussian_point();
     const auto [x2, y2] = gaussian_point();
     // A test between (nearly) the same pixel carries no information.
     if ((x1 - x2) * (x1 - x2) + (y1 - y2) * (y1 - y2) < 4.0F) continue;
     pattern.push_back({x1, y1, x2, y2});
   }
+  return pattern;
+}
+
+namespace {
+#include "brief_pattern_indices.inc"
+}  // namespace
+
+std::vector<BriefPair> make_brief_pattern(int patch_size) {
+  if (patch_size != 31 || kLearnedPairs.empty()) return make_brief_candidates(patch_size, 256);
+  const auto pool = make_brief_candidates(31, kLearnedPoolSize);
+  std::vector<BriefPair> pattern;
+  pattern.reserve(kLearnedPairs.size());
+  for (const auto index : kLearnedPairs) pattern.push_back(pool[index]);
   return pattern;
 }
 

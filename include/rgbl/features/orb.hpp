@@ -47,9 +47,15 @@ struct BriefPair {
   float x1, y1, x2, y2;
 };
 
-// The 256 sampling pairs: drawn from a fixed-seed generator (SplitMix64 + Box-Muller), isotropic
-// Gaussian with sigma = patch_size / 5, clipped to the disc of radius patch_size / 2. The same
-// patch_size always gives the same pattern on every platform.
+// `count` candidate sampling pairs from a fixed-seed generator (SplitMix64 + Box-Muller): isotropic
+// Gaussian with sigma = patch_size / 5, clipped to the disc of radius patch_size / 2, points of a
+// pair >= 2 px apart. The same arguments give the same pairs on every platform; a longer pool starts
+// with the shorter one.
+std::vector<BriefPair> make_brief_candidates(int patch_size, int count);
+
+// The 256 pairs the extractor uses. For patch_size 31: 256 of the first 4096 candidates, chosen
+// offline by apps/learn_brief_pattern (tests with a mean near 0.5 and low mutual correlation on
+// real patches, the ORB paper's criterion); for other sizes the first 256 candidates.
 std::vector<BriefPair> make_brief_pattern(int patch_size);
 
 // Owns the pyramid and scratch buffers, so reusing one extractor across frames allocates nothing in
