@@ -11,6 +11,10 @@
 #include <cmath>
 #include <cstdint>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace rgbl {
 
 void OrbOptions::validate() const {
@@ -51,6 +55,56 @@ class SplitMix64 {
 };
 
 inline int round_to_int(float v) { return static_cast<int>(v + (v >= 0.0F ? 0.5F : -0.5F)); }
+
+#if defined(__SSE2__)
+inline __m128i load16(const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
+
+inline int horizontal_sum(__m128i v) {
+  v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0x4E));
+  v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0xB1));
+  return _mm_cvtsi128_si32(v);
+}
+
+// Intensity-centroid moments over the disc of radius <= 15: each row pair (+v, -v) as 32 bytes
+// (u = -16..15) masked to the disc, widened to 16 bits; m10 by multiply-add with u, m01 with v.
+// `masks` holds 32 bytes per row offset v (0xFF where |u| <= half width). Needs 16 px left and 15 px
+// right of the centre inside the image.
+inline void centroid_moments_sse2(const std::uint8_t* centre, int step, int radius, const std::uint8_t* masks,
+                                  int& m10, int& m01) {
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i u0 = _mm_setr_epi16(-16, -15, -14, -13, -12, -11, -10, -9);
+  const __m128i u1 = _mm_setr_epi16(-8, -7, -6, -5, -4, -3, -2, -1);
+  const __m128i u2 = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m128i u3 = _mm_setr_epi16(8, 9, 10, 11, 12, 13, 14, 15);
+  __m128i acc10 = zero, acc01 = zero;
+  for (int v = 0; v <= radius; ++v) {
+    const __m128i mask_lo = load16(masks + 32 * v), mask_hi = load16(masks + 32 * v + 16);
+    const std::uint8_t* below = centre + v * step;
+    const __m128i b_lo = _mm_and_si128(load16(below - 16), mask_lo), b_hi = _mm_and_si128(load16(below), mask_hi);
+    __m128i a_lo = zero, a_hi = zero;
+    if (v > 0) {
+      const std::uint8_t* above = centre - v * step;
+      a_lo = _mm_and_si128(load16(above - 16), mask_lo);
+      a_hi = _mm_and_si128(load16(above), mask_hi);
+    }
+    const __m128i b0 = _mm_unpacklo_epi8(b_lo, zero), b1 = _mm_unpackhi_epi8(b_lo, zero);
+    const __m128i b2 = _mm_unpacklo_epi8(b_hi, zero), b3 = _mm_unpackhi_epi8(b_hi, zero);
+    const __m128i a0 = _mm_unpacklo_epi8(a_lo, zero), a1 = _mm_unpackhi_epi8(a_lo, zero);
+    const __m128i a2 = _mm_unpacklo_epi8(a_hi, zero), a3 = _mm_unpackhi_epi8(a_hi, zero);
+    acc10 = _mm_add_epi32(acc10, _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_add_epi16(b0, a0), u0),
+                                                             _mm_madd_epi16(_mm_add_epi16(b1, a1), u1)),
+                                               _mm_add_epi32(_mm_madd_epi16(_mm_add_epi16(b2, a2), u2),
+                                                             _mm_madd_epi16(_mm_add_epi16(b3, a3), u3))));
+    if (v > 0) {
+      const __m128i diff = _mm_add_epi16(_mm_add_epi16(_mm_sub_epi16(b0, a0), _mm_sub_epi16(b1, a1)),
+                                         _mm_add_epi16(_mm_sub_epi16(b2, a2), _mm_sub_epi16(b3, a3)));
+      acc01 = _mm_add_epi32(acc01, _mm_madd_epi16(diff, _mm_set1_epi16(static_cast<short>(v))));
+    }
+  }
+  m10 = horizontal_sum(acc10);
+  m01 = horizontal_sum(acc01);
+}
+#endif
 
 }  // namespace
 
@@ -119,6 +173,17 @@ OrbExtractor::OrbExtractor(const OrbOptions& options) : options_(options) {
   for (int v = 0; v <= r; ++v) {
     disc_half_width_[static_cast<std::size_t>(v)] =
         static_cast<int>(std::floor(std::sqrt(static_cast<double>(r * r - v * v)) + 0.5));
+  }
+  // Row masks for the SIMD centroid: 32 bytes per row, u = -16..15 (needs r <= 15 and 16 px of border).
+  if (r <= 15 && options_.edge_threshold >= 16) {
+    disc_masks_.assign(static_cast<std::size_t>(r + 1) * 32, 0);
+    for (int v = 0; v <= r; ++v) {
+      for (int u = -16; u < 16; ++u) {
+        if (std::abs(u) <= disc_half_width_[static_cast<std::size_t>(v)]) {
+          disc_masks_[static_cast<std::size_t>(v * 32 + u + 16)] = 0xFF;
+        }
+      }
+    }
   }
   pyramid_.resize(static_cast<std::size_t>(levels));
 }
@@ -310,6 +375,12 @@ void OrbExtractor::describe_level(int level, std::span<const Candidate> selected
     // Intensity centroid over the disc: rows +v and -v together.
     const std::uint8_t* centre = img.ptr<std::uint8_t>(cy) + cx;
     int m10 = 0, m01 = 0;
+#if defined(__SSE2__)
+    if (!disc_masks_.empty()) {
+      centroid_moments_sse2(centre, step, r, disc_masks_.data(), m10, m01);
+    } else
+#endif
+    {
     for (int u = -r; u <= r; ++u) m10 += u * centre[u];
     for (int v = 1; v <= r; ++v) {
       const int w = disc_half_width_[static_cast<std::size_t>(v)];
@@ -323,6 +394,7 @@ void OrbExtractor::describe_level(int level, std::span<const Candidate> selected
       }
       m01 += v * sum_diff;
       m10 += sum_x;
+    }
     }
     float angle = std::atan2(static_cast<float>(m01), static_cast<float>(m10)) * kRadToDeg;
     if (angle < 0.0F) angle += 360.0F;

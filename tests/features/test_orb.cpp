@@ -172,6 +172,36 @@ TEST_CASE("ORB: exact feature count, levels, borders and budgets on a real frame
   for (int l = 0; l < 8; ++l) CHECK(per_level[static_cast<std::size_t>(l)] > 0);
 }
 
+TEST_CASE("ORB: orientation is the intensity centroid angle over the radius-15 disc", "[features][orb]") {
+  const cv::Mat img = textured_image(1226, 370);
+  rgbl::OrbExtractor extractor;
+  std::vector<rgbl::Keypoint> kps;
+  std::vector<rgbl::Descriptor> desc;
+  extractor.extract(img, kps, desc);
+  REQUIRE(kps.size() == 2000);
+  for (std::size_t i = 0; i < kps.size(); i += 7) {
+    const auto& k = kps[i];
+    const cv::Mat& level = extractor.pyramid()[static_cast<std::size_t>(k.level)];
+    const float s = extractor.level_scales()[static_cast<std::size_t>(k.level)];
+    const int cx = static_cast<int>(std::lround(k.x / s)), cy = static_cast<int>(std::lround(k.y / s));
+    double m10 = 0, m01 = 0;
+    for (int v = -15; v <= 15; ++v) {
+      const int w = static_cast<int>(std::floor(std::sqrt(225.0 - v * v) + 0.5));
+      for (int u = -w; u <= w; ++u) {
+        const double value = level.at<std::uint8_t>(cy + v, cx + u);
+        m10 += u * value;
+        m01 += v * value;
+      }
+    }
+    double expected = std::atan2(m01, m10) * 180.0 / 3.14159265358979323846;
+    if (expected < 0) expected += 360.0;
+    double diff = std::abs(expected - k.angle);
+    diff = std::min(diff, 360.0 - diff);
+    INFO("keypoint " << i << " level " << k.level);
+    REQUIRE(diff < 1e-2);
+  }
+}
+
 TEST_CASE("ORB: deterministic, same image gives identical keypoints and descriptors", "[features][orb]") {
   const cv::Mat img = textured_image(1226, 370);
   rgbl::OrbExtractor extractor;

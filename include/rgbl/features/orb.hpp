@@ -96,6 +96,7 @@ class OrbExtractor {
   std::vector<int> budgets_;
   std::vector<BriefPair> pattern_;
   std::vector<int> disc_half_width_;  // per row offset 0..radius: half width of the orientation disc
+  std::vector<std::uint8_t> disc_masks_;  // the same disc as 32-byte row masks for the SIMD path
   // Scratch reused across calls.
   std::vector<cv::Mat> pyramid_;
   cv::Mat blurred_;
