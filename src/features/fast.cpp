@@ -167,7 +167,8 @@ bool cpu_has_avx2() {
 
 }  // namespace
 
-void fast_score_map(const cv::Mat& img, cv::Rect region, int threshold, std::vector<std::uint8_t>& scores) {
+void fast_score_map(const cv::Mat& img, cv::Rect region, int threshold, std::vector<std::uint8_t>& scores,
+                    bool allow_avx2) {
   const int map_w = region.width + 2;
   // 16 bytes of padding let the non-maximum pass read whole 16-byte blocks at the end of the map.
   scores.assign(static_cast<std::size_t>(map_w) * static_cast<std::size_t>(region.height + 2) + 16, 0);
@@ -179,8 +180,10 @@ void fast_score_map(const cv::Mat& img, cv::Rect region, int threshold, std::vec
     std::uint8_t* out = scores.data() + static_cast<std::size_t>(y - region.y + 1) * static_cast<std::size_t>(map_w) + 1;
     int x = region.x;
     const int end = region.x + region.width;
-#if defined(RGBL_HAVE_AVX2_PATH)
-    if (region.width >= 32 && cpu_has_avx2()) {
+#if !defined(RGBL_HAVE_AVX2_PATH)
+    (void)allow_avx2;
+#else
+    if (allow_avx2 && region.width >= 32 && cpu_has_avx2()) {
       row_scores_avx2(row, x, end, offsets, threshold, out);
       continue;
     }

@@ -121,6 +121,26 @@ TEST_CASE("FAST scores: the same corner set as cv::FAST at every threshold", "[f
     CHECK(ours.size() > 500);
     CHECK(ours == theirs);
   }
+  // Every code path (AVX2 32-wide, SSE2 16-wide, scalar tails and narrow regions) gives the same map.
+  std::vector<std::uint8_t> other;
+  for (const int width : {5, 12, 16, 20, 31, 40, 77, img.cols - 6}) {
+    const cv::Rect r(3, 3, width, img.rows - 6);
+    rgbl::detail::fast_score_map(img, r, 7, scores, true);
+    rgbl::detail::fast_score_map(img, r, 7, other, false);
+    INFO("width " << width);
+    CHECK(scores == other);
+    // ... and the same as the full-width map restricted to the region.
+    std::vector<std::uint8_t> full;
+    rgbl::detail::fast_score_map(img, region, 7, full);
+    int mismatches = 0;
+    for (int y = 0; y < r.height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        mismatches += scores[static_cast<std::size_t>((y + 1) * (width + 2) + x + 1)] !=
+                      full[static_cast<std::size_t>((y + 1) * (region.width + 2) + x + 1)];
+      }
+    }
+    CHECK(mismatches == 0);
+  }
   // A score is the largest threshold at which the pixel is still a corner.
   rgbl::detail::fast_score_map(img, region, 7, scores);
   std::vector<std::uint8_t> at_score;
