@@ -142,6 +142,35 @@ bool cpu_has_popcnt() {
 }
 #endif
 
+// Hamming distances from q to the candidates' descriptors, with the same POPCNT dispatch.
+[[gnu::always_inline]] inline void candidate_distances_impl(const Descriptor& q, std::span<const Descriptor> descriptors,
+                                                            const std::vector<int>& candidates, std::vector<int>& out) {
+  out.resize(candidates.size());
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    out[i] = hamming_words(q, descriptors[static_cast<std::size_t>(candidates[i])]);
+  }
+}
+
+#if defined(RGBL_HAVE_POPCNT_PATH)
+__attribute__((target("popcnt"))) void candidate_distances_popcnt(const Descriptor& q,
+                                                                  std::span<const Descriptor> descriptors,
+                                                                  const std::vector<int>& candidates,
+                                                                  std::vector<int>& out) {
+  candidate_distances_impl(q, descriptors, candidates, out);
+}
+#endif
+
+void candidate_distances(const Descriptor& q, std::span<const Descriptor> descriptors, const std::vector<int>& candidates,
+                         std::vector<int>& out) {
+#if defined(RGBL_HAVE_POPCNT_PATH)
+  if (cpu_has_popcnt()) {
+    candidate_distances_popcnt(q, descriptors, candidates, out);
+    return;
+  }
+#endif
+  candidate_distances_impl(q, descriptors, candidates, out);
+}
+
 }  // namespace
 
 std::vector<int> match_guided(std::span<const GuidedQuery> queries, const FeatureGrid& grid,
@@ -155,7 +184,7 @@ std::vector<int> match_guided(std::span<const GuidedQuery> queries, const Featur
   std::vector<int> distance_of_query(queries.size(), kNone);
   // Which query currently owns each keypoint (-1: none); a better query takes it over.
   std::vector<int> owner(keypoints.size(), -1);
-  std::vector<int> candidates;
+  std::vector<int> candidates, distances;
 
   for (std::size_t qi = 0; qi < queries.size(); ++qi) {
     const GuidedQuery& q = queries[qi];
@@ -163,8 +192,10 @@ std::vector<int> match_guided(std::span<const GuidedQuery> queries, const Featur
     const float r = options.radius * std::pow(options.scale_factor, static_cast<float>(std::max(q.level, 0)));
     grid.query(q.x, q.y, r, q.level - options.level_window, q.level + options.level_window, candidates);
     int best = kNone, second = kNone, best_index = -1, best_level = -1, second_level = -1;
-    for (const int index : candidates) {
-      const int d = hamming_distance(*q.descriptor, descriptors[static_cast<std::size_t>(index)]);
+    candidate_distances(*q.descriptor, descriptors, candidates, distances);
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+      const int index = candidates[c];
+      const int d = distances[c];
       const int level = keypoints[static_cast<std::size_t>(index)].level;
       if (d < best) {
         second = best;

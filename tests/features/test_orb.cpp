@@ -13,6 +13,7 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <type_traits>
 
 namespace {
 
@@ -221,6 +222,9 @@ TEST_CASE("ORB: orientation is the intensity centroid angle over the radius-15 d
     REQUIRE(diff < 1e-2);
   }
 }
+
+static_assert(!std::is_copy_constructible_v<rgbl::OrbExtractor>);
+static_assert(std::is_nothrow_move_constructible_v<rgbl::OrbExtractor>);
 
 TEST_CASE("ORB: deterministic, same image gives identical keypoints and descriptors", "[features][orb]") {
   const cv::Mat img = textured_image(1226, 370);

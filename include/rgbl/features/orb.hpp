@@ -59,10 +59,16 @@ std::vector<BriefPair> make_brief_candidates(int patch_size, int count);
 std::vector<BriefPair> make_brief_pattern(int patch_size);
 
 // Owns the pyramid and scratch buffers, so reusing one extractor across frames allocates nothing in
-// steady state. Not thread-safe: one extractor per thread.
+// steady state. Not thread-safe: one extractor per thread. Move-only, because copies of its cv::Mat
+// scratch would share pixel buffers (and race when used from two threads).
 class OrbExtractor {
  public:
   explicit OrbExtractor(const OrbOptions& options = {});
+  OrbExtractor(const OrbExtractor&) = delete;
+  OrbExtractor& operator=(const OrbExtractor&) = delete;
+  OrbExtractor(OrbExtractor&&) noexcept = default;
+  OrbExtractor& operator=(OrbExtractor&&) noexcept = default;
+  ~OrbExtractor() = default;
 
   // `gray`: CV_8UC1. Clears and fills `keypoints` (level-0 pixel coordinates) and `descriptors` (same
   // length and order). Ordered by level, then by position within the level's quadtree. Deterministic.
