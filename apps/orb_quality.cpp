@@ -23,6 +23,7 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -44,6 +45,7 @@ struct Features {
 
 struct Totals {
   double features = 0, matches = 0, gt_inliers = 0, ransac_inliers = 0, extract_ms = 0;
+  double occupied = 0;  // share of a 32 x 10 grid's cells (~38 px) holding a keypoint, summed over frames
   double guided_queries = 0, guided_matches = 0, guided_gt_inliers = 0;
   int pairs = 0;
 };
@@ -135,6 +137,16 @@ void accumulate(Totals& t, const Features& a, const Features& b, const Eigen::Ma
   options.cross_check = true;
   const auto matches = rgbl::match_brute_force(a.descriptors, b.descriptors, options);
   t.features += 0.5 * static_cast<double>(a.points.size() + b.points.size());
+  {
+    constexpr int kCols = 32, kRows = 10;
+    std::vector<char> cells(kCols * kRows, 0);
+    for (const auto& p : a.points) {
+      const int cx = std::clamp(static_cast<int>(p.x * kCols / static_cast<float>(a.depth.cols)), 0, kCols - 1);
+      const int cy = std::clamp(static_cast<int>(p.y * kRows / static_cast<float>(a.depth.rows)), 0, kRows - 1);
+      cells[static_cast<std::size_t>(cy * kCols + cx)] = 1;
+    }
+    t.occupied += static_cast<double>(std::count(cells.begin(), cells.end(), 1)) / (kCols * kRows);
+  }
   t.matches += static_cast<double>(matches.size());
   std::vector<cv::Point2f> pa, pb;
   for (const auto& m : matches) {
@@ -152,8 +164,8 @@ void accumulate(Totals& t, const Features& a, const Features& b, const Eigen::Ma
 
 void print_row(const char* name, const Totals& t) {
   const double n = t.pairs;
-  fmt::print("| {:<8} | {:8.0f} | {:9.2f} | {:8.1f} | {:>16} | {:>16} | {:8.1f} | {:8.1f} | {:>16} |\n", name,
-             t.features / n, t.extract_ms / n, t.matches / n,
+  fmt::print("| {:<8} | {:8.0f} | {:7.1f}% | {:9.2f} | {:8.1f} | {:>16} | {:>16} | {:8.1f} | {:8.1f} | {:>16} |\n", name,
+             t.features / n, 100.0 * t.occupied / n, t.extract_ms / n, t.matches / n,
              fmt::format("{:.1f} ({:.1f}%)", t.gt_inliers / n, 100.0 * t.gt_inliers / t.matches),
              fmt::format("{:.1f} ({:.1f}%)", t.ransac_inliers / n, 100.0 * t.ransac_inliers / t.matches),
              t.guided_queries / n, t.guided_matches / n,
@@ -236,11 +248,11 @@ int main(int argc, char** argv) {
                "mean per pair.\n"
                "global: brute force, ratio 0.8, cross check. guided: keypoints with LiDAR depth predicted with the "
                "ground-truth motion, match_guided defaults. agree = Sampson distance to the ground-truth epipolar "
-               "geometry < 1 px.\n\n",
+               "geometry < 1 px. occupied cells: share of a 32 x 10 grid holding a keypoint.\n\n",
                pairs, seq.string(), orb_options.features_per_node);
-    fmt::print("| extractor | features | ms/frame | global matches | global agree | F-RANSAC inliers | guided queries "
+    fmt::print("| extractor | features | occupied cells | ms/frame | global matches | global agree | F-RANSAC inliers | guided queries "
                "| guided matches | guided agree |\n");
-    fmt::print("|---|---|---|---|---|---|---|---|---|\n");
+    fmt::print("|---|---|---|---|---|---|---|---|---|---|\n");
     print_row("rgbl", ours);
     print_row("cv::ORB", theirs);
     return 0;
