@@ -5,6 +5,7 @@
 #include <opencv2/core.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -81,12 +82,142 @@ struct Inversion {
   }
 };
 
-// Row-wise running max of width 2h+1 from the level h-1 (width 2h-1) of the same row: the union of
-// the windows at x-1 and x+1. Rows carry `pad` zero cells on both sides.
-void widen(const float* __restrict narrow, float* __restrict wide, int width) {
+// Eight floats as one GCC/Clang vector: compiles to SSE pairs by default and to AVX where the
+// target_clones below pick it at run time. `a > b ? a : b` is exactly x86 MAXPS.
+using Floats = float __attribute__((vector_size(32)));
+using Mask = std::int32_t __attribute__((vector_size(32)));
+constexpr int kLanes = 8;
+
+// Internal helpers, always inlined: their vector ABI never matters (-Wno-psabi for this file).
+[[gnu::always_inline]] inline Floats load(const float* p) {
+  Floats v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+}
+[[gnu::always_inline]] inline void store(float* p, Floats v) { std::memcpy(p, &v, sizeof(v)); }
+[[gnu::always_inline]] inline Floats splat(float x) { return Floats{} + x; }
+[[gnu::always_inline]] inline Floats vmax(Floats a, Floats b) { return a > b ? a : b; }
+
+// Scratch rows for one dilation: a ring of 2R+1 input rows, each with its running maxima of every
+// half-width 0..R ("levels"), padded with zeros so that widening and the vector tails never read
+// outside. Level h of a row holds max(v[x-h .. x+h]).
+class RowRing {
+ public:
+  RowRing(int width, int radius)
+      : width_(width), radius_(radius), ring_(2 * radius + 1), levels_(radius + 1),
+        pad_(((radius + kLanes) / kLanes) * kLanes),
+        stride_(((width + kLanes - 1) / kLanes) * kLanes + 2 * pad_),
+        buffer_(static_cast<std::size_t>(ring_) * static_cast<std::size_t>(levels_) * static_cast<std::size_t>(stride_), 0.0F) {}
+
+  float* row(int r, int level) {
+    return buffer_.data() +
+           (static_cast<std::size_t>(r % ring_) * static_cast<std::size_t>(levels_) + static_cast<std::size_t>(level)) *
+               static_cast<std::size_t>(stride_) +
+           static_cast<std::size_t>(pad_);
+  }
+  int width() const { return width_; }
+  int radius() const { return radius_; }
+  int vector_width() const { return ((width_ + kLanes - 1) / kLanes) * kLanes; }
+
+ private:
+  int width_, radius_, ring_, levels_, pad_, stride_;
+  std::vector<float> buffer_;
+};
+
+// Inverts one input row into level 0 and returns whether it holds any depth; the padding stays 0.
+__attribute__((target_clones("avx", "default"))) bool invert_row(const float* __restrict src, float* __restrict dst,
+                                                                  int width, float m, float threshold) {
+  const Floats vm = splat(m), vt = splat(threshold), zero{};
+  // Any set bit in a depth marks the row as used (a negative or too-far depth just costs the work).
+  Mask any{};
+  int x = 0;
+  for (; x + kLanes <= width; x += kLanes) {
+    const Floats d = load(src + x);
+    const Floats v = vm - d;
+    any |= std::bit_cast<Mask>(d);
+    // no clamp of negative v (d > M): it never outranks an empty cell's 0 and maps back to 0
+    store(dst + x, v > vt ? zero : v);
+  }
+  bool tail_any = false;
+  for (; x < width; ++x) {
+    const float v = m - src[x];
+    dst[x] = v > threshold ? 0.0F : v;
+    tail_any |= src[x] != 0.0F;
+  }
+  for (int i = 0; i < kLanes; ++i) tail_any |= any[i] != 0;
+  return tail_any;
+}
+
+// Whether a row holds any non-zero bit, stopping at the first.
+__attribute__((target_clones("avx", "default"))) bool has_depth(const float* row, int width) {
+  int x = 0;
+  for (; x + 4 * kLanes <= width; x += 4 * kLanes) {
+    const Mask any = std::bit_cast<Mask>(load(row + x)) | std::bit_cast<Mask>(load(row + x + kLanes)) |
+                     std::bit_cast<Mask>(load(row + x + 2 * kLanes)) | std::bit_cast<Mask>(load(row + x + 3 * kLanes));
+    Mask zero{};
+    if (std::memcmp(&any, &zero, sizeof(any)) != 0) return true;
+  }
+  for (; x < width; ++x) {
+    if (std::bit_cast<std::uint32_t>(row[x]) != 0) return true;
+  }
+  return false;
+}
+
+// Level h from level h-1: the union of the windows at x-1 and x+1 (level 1 reads level 0 at x too).
+__attribute__((target_clones("avx", "default"))) void widen_row(const float* __restrict narrow, float* __restrict wide,
+                                                                 int vector_width, bool first) {
+  if (first) {
+    for (int x = 0; x < vector_width; x += kLanes)
+      store(wide + x, vmax(vmax(load(narrow + x - 1), load(narrow + x)), load(narrow + x + 1)));
+  } else {
+    for (int x = 0; x < vector_width; x += kLanes) store(wide + x, vmax(load(narrow + x - 1), load(narrow + x + 1)));
+  }
+}
+
+// One output row: the max over N level rows, inverted back. N is a compile-time constant so that the
+// row pointers live in registers and the max chain is unrolled.
+template <int N>
+[[gnu::always_inline]] inline void combine_fixed(const float* const* sources, float* __restrict out, int width, float m,
+                                                 float threshold) {
+  const float* rows[N];
+  for (int s = 0; s < N; ++s) rows[s] = sources[s];
+  const Floats vm = splat(m), vt = splat(threshold), zero{};
+  int x = 0;
+  for (; x + kLanes <= width; x += kLanes) {
+    Floats acc = load(rows[0] + x);
+    for (int s = 1; s < N; ++s) acc = vmax(acc, load(rows[s] + x));
+    const Floats d = vm - acc;
+    store(out + x, d > vt ? zero : d);
+  }
+  for (; x < width; ++x) {
+    float acc = rows[0][x];
+    for (int s = 1; s < N; ++s) acc = acc > rows[s][x] ? acc : rows[s][x];
+    const float d = m - acc;
+    out[x] = d > threshold ? 0.0F : d;
+  }
+}
+
+__attribute__((target_clones("avx", "default"))) void combine_rows(const float* const* sources, int count,
+                                                                    float* __restrict out, int width, float m,
+                                                                    float threshold) {
+  switch (count) {
+    case 1: return combine_fixed<1>(sources, out, width, m, threshold);
+    case 2: return combine_fixed<2>(sources, out, width, m, threshold);
+    case 3: return combine_fixed<3>(sources, out, width, m, threshold);
+    case 4: return combine_fixed<4>(sources, out, width, m, threshold);
+    case 5: return combine_fixed<5>(sources, out, width, m, threshold);
+    case 6: return combine_fixed<6>(sources, out, width, m, threshold);
+    case 7: return combine_fixed<7>(sources, out, width, m, threshold);
+    case 8: return combine_fixed<8>(sources, out, width, m, threshold);
+    case 9: return combine_fixed<9>(sources, out, width, m, threshold);
+    default: break;
+  }
+  // kernels taller than 9 rows: a plain loop (rare, not benchmarked)
   for (int x = 0; x < width; ++x) {
-    const float a = narrow[x - 1], b = narrow[x + 1];
-    wide[x] = a > b ? a : b;
+    float acc = sources[0][x];
+    for (int s = 1; s < count; ++s) acc = acc > sources[s][x] ? acc : sources[s][x];
+    const float d = m - acc;
+    out[x] = d > threshold ? 0.0F : d;
   }
 }
 
@@ -102,73 +233,35 @@ void dilate_depth(const cv::Mat_<float>& sparse, const DilationOptions& options,
   if (width == 0 || height == 0) return;
   const int radius = kernel.radius();
   const Inversion inv(options.max_depth);
-
-  // A ring of 2R+1 input rows; for each, the running maxima of every half-width 0..R, each padded
-  // with R+1 zero cells on both sides so that widening never reads outside.
-  const int pad = radius + 1;
-  const int stride = width + 2 * pad;
-  const int ring = 2 * radius + 1;
-  const int levels = radius + 1;
-  std::vector<float> buffer(static_cast<std::size_t>(ring) * levels * stride, 0.0F);
+  RowRing ring(width, radius);
   std::vector<std::uint8_t> row_valid(static_cast<std::size_t>(height), 0);
-  auto level_row = [&](int row, int level) {
-    return buffer.data() + (static_cast<std::size_t>(row % ring) * levels + level) * stride + pad;
-  };
 
-  // Fills ring slot of input row r; returns whether the row holds any depth.
   auto load_row = [&](int r) {
-    const float* src = sparse[r];
-    float* v0 = level_row(r, 0);
-    float any = 0.0F;
-    for (int x = 0; x < width; ++x) {
-      const float v = inv.forward(src[x]);
-      v0[x] = v;
-      any = any > v ? any : v;
-    }
-    const bool valid = any > 0.0F;
+    // Rows without any sample (the top third of a KITTI frame) are only scanned, never inverted.
+    const bool valid = has_depth(sparse[r], width) && invert_row(sparse[r], ring.row(r, 0), width, inv.m, inv.threshold);
     row_valid[static_cast<std::size_t>(r)] = valid ? 1 : 0;
-    if (valid) {
-      for (int level = 1; level < levels; ++level) {
-        if (level == 1) {
-          float* v1 = level_row(r, 1);
-          for (int x = 0; x < width; ++x) {
-            const float a = v0[x - 1], b = v0[x], c = v0[x + 1];
-            const float ab = a > b ? a : b;
-            v1[x] = ab > c ? ab : c;
-          }
-        } else {
-          widen(level_row(r, level - 1), level_row(r, level), width);
-        }
-      }
+    if (!valid) return;
+    for (int level = 1; level <= radius; ++level) {
+      widen_row(ring.row(r, level - 1), ring.row(r, level), ring.vector_width(), level == 1);
     }
   };
 
-  const int rows_ahead = std::min(radius, height);
-  for (int r = 0; r < rows_ahead; ++r) load_row(r);
-
+  for (int r = 0; r < std::min(radius, height); ++r) load_row(r);
   std::vector<const float*> sources;
-  sources.reserve(static_cast<std::size_t>(ring));
+  sources.reserve(static_cast<std::size_t>(2 * radius + 1));
   for (int y = 0; y < height; ++y) {
     if (y + radius < height) load_row(y + radius);
     sources.clear();
     for (int dy = -radius; dy <= radius; ++dy) {
       const int r = y + dy;
       if (r < 0 || r >= height || row_valid[static_cast<std::size_t>(r)] == 0) continue;
-      const int h = kernel.half_width(dy);
-      sources.push_back(level_row(r, h));
+      sources.push_back(ring.row(r, kernel.half_width(dy)));
     }
-    float* out = dense[y];
     if (sources.empty()) {
-      std::memset(out, 0, sizeof(float) * static_cast<std::size_t>(width));
-      continue;
+      std::memset(dense[y], 0, sizeof(float) * static_cast<std::size_t>(width));
+    } else {
+      combine_rows(sources.data(), static_cast<int>(sources.size()), dense[y], width, inv.m, inv.threshold);
     }
-    const float* first = sources[0];
-    for (int x = 0; x < width; ++x) out[x] = first[x];
-    for (std::size_t s = 1; s < sources.size(); ++s) {
-      const float* src = sources[s];
-      for (int x = 0; x < width; ++x) out[x] = out[x] > src[x] ? out[x] : src[x];
-    }
-    for (int x = 0; x < width; ++x) out[x] = inv.back(out[x]);
   }
 }
 
