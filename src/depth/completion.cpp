@@ -271,52 +271,79 @@ cv::Mat_<float> dilate_depth(const cv::Mat_<float>& sparse, const DilationOption
   return dense;
 }
 
-KeypointDepth lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, const Eigen::Vector2f& pixel) {
+namespace {
+
+// The kernel as a list of cells, prepared once per batch of keypoints.
+struct Cell {
+  int dx, dy;
+};
+
+std::vector<Cell> kernel_cells(const Kernel& kernel) {
+  std::vector<Cell> cells;
+  cells.reserve(static_cast<std::size_t>(kernel.cell_count()));
+  for (int dy = -kernel.radius(); dy <= kernel.radius(); ++dy) {
+    const int h = kernel.half_width(dy);
+    for (int dx = -h; dx <= h; ++dx) cells.push_back({dx, dy});
+  }
+  return cells;
+}
+
+KeypointDepth lookup_one(const cv::Mat_<float>& sparse, std::span<const Cell> cells, int radius, const Inversion& inv,
+                         const Eigen::Vector2f& pixel) {
   KeypointDepth result;
   const float fx = std::floor(pixel.x() + 0.5F), fy = std::floor(pixel.y() + 0.5F);
   if (!(fx >= 0.0F && fy >= 0.0F && fx < static_cast<float>(sparse.cols) && fy < static_cast<float>(sparse.rows))) {
     return result;
   }
   const int x = static_cast<int>(fx), y = static_cast<int>(fy);
-  const Kernel kernel = options.kernel();
-  const Inversion inv(options.max_depth);
-  const int radius = kernel.radius();
+  const bool inside = x >= radius && y >= radius && x + radius < sparse.cols && y + radius < sparse.rows;
+  const float* centre = sparse[y] + x;
+  const auto step = static_cast<std::ptrdiff_t>(sparse.step1());
+  // First pass: the winning inverted value and the depth range; cells outside the image are skipped.
   float best = 0.0F;
-  float best_distance2 = std::numeric_limits<float>::max();
   float lo = std::numeric_limits<float>::max(), hi = 0.0F;
-  for (int dy = -radius; dy <= radius; ++dy) {
-    const int r = y + dy;
-    if (r < 0 || r >= sparse.rows) continue;
-    const int h = kernel.half_width(dy);
-    const float* row = sparse[r];
-    const int x0 = std::max(0, x - h), x1 = std::min(sparse.cols - 1, x + h);
-    for (int c = x0; c <= x1; ++c) {
-      const float d = row[c];
-      const float v = inv.forward(d);
-      if (v <= 0.0F) continue;
+  for (const Cell& cell : cells) {
+    if (!inside && (x + cell.dx < 0 || y + cell.dy < 0 || x + cell.dx >= sparse.cols || y + cell.dy >= sparse.rows)) continue;
+    const float d = centre[cell.dy * step + cell.dx];
+    const float v = inv.forward(d);
+    if (v > 0.0F) {
       lo = std::min(lo, d);
       hi = std::max(hi, d);
-      const float ex = static_cast<float>(c) - pixel.x(), ey = static_cast<float>(r) - pixel.y();
-      const float distance2 = ex * ex + ey * ey;
-      if (v > best || (v == best && distance2 < best_distance2)) {
-        best = v;
-        best_distance2 = distance2;
-      }
+      best = std::max(best, v);
     }
   }
   if (best <= 0.0F) return result;
   result.z = inv.back(best);
-  if (result.z <= 0.0F) return result;
+  if (result.z <= 0.0F) return {};
+  // Second pass, only for keypoints with depth: the nearest cell holding the winning value.
+  float best_distance2 = std::numeric_limits<float>::max();
+  for (const Cell& cell : cells) {
+    if (!inside && (x + cell.dx < 0 || y + cell.dy < 0 || x + cell.dx >= sparse.cols || y + cell.dy >= sparse.rows)) continue;
+    if (inv.forward(centre[cell.dy * step + cell.dx]) != best) continue;
+    const float ex = static_cast<float>(x + cell.dx) - pixel.x(), ey = static_cast<float>(y + cell.dy) - pixel.y();
+    best_distance2 = std::min(best_distance2, ex * ex + ey * ey);
+  }
   result.sample_distance_px = std::sqrt(best_distance2);
   result.spread = hi - lo;
   return result;
+}
+
+}  // namespace
+
+KeypointDepth lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, const Eigen::Vector2f& pixel) {
+  KeypointDepth out;
+  lookup_depth(sparse, options, std::span<const Eigen::Vector2f>(&pixel, 1), std::span<KeypointDepth>(&out, 1));
+  return out;
 }
 
 void lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, std::span<const Eigen::Vector2f> pixels,
                   std::span<KeypointDepth> out) {
   options.validate();
   CV_Assert(out.size() == pixels.size());
-  for (std::size_t i = 0; i < pixels.size(); ++i) out[i] = lookup_depth(sparse, options, pixels[i]);
+  const Kernel kernel = options.kernel();
+  const std::vector<Cell> cells = kernel_cells(kernel);
+  const Inversion inv(options.max_depth);
+  for (std::size_t i = 0; i < pixels.size(); ++i) out[i] = lookup_one(sparse, cells, kernel.radius(), inv, pixels[i]);
 }
 
 double depth_density(const cv::Mat_<float>& depth) {
