@@ -104,24 +104,34 @@ constexpr int kLanes = 8;
 class RowRing {
  public:
   RowRing(int width, int radius)
-      : width_(width), radius_(radius), ring_(2 * radius + 1), levels_(radius + 1),
-        pad_(((radius + kLanes) / kLanes) * kLanes),
-        stride_(((width + kLanes - 1) / kLanes) * kLanes + 2 * pad_),
-        buffer_(static_cast<std::size_t>(ring_) * static_cast<std::size_t>(levels_) * static_cast<std::size_t>(stride_), 0.0F) {}
+      : width_(width), ring_(2 * radius + 1), levels_(radius + 1),
+        stride_(round_up(round_up(width, kLanes) + 2 * kPad, kLineFloats)),
+        buffer_(static_cast<std::size_t>(ring_) * static_cast<std::size_t>(levels_) * static_cast<std::size_t>(stride_) +
+                    kLineFloats,
+                0.0F) {
+    // Rows start on a cache line, so that the aligned half of the loads never straddles two lines.
+    const auto address = reinterpret_cast<std::uintptr_t>(buffer_.data());
+    base_ = buffer_.data() + (round_up(static_cast<int>(address % 64), 64) - static_cast<int>(address % 64)) / 4;
+  }
+  RowRing(const RowRing&) = delete;
+  RowRing& operator=(const RowRing&) = delete;
 
   float* row(int r, int level) {
-    return buffer_.data() +
+    return base_ +
            (static_cast<std::size_t>(r % ring_) * static_cast<std::size_t>(levels_) + static_cast<std::size_t>(level)) *
                static_cast<std::size_t>(stride_) +
-           static_cast<std::size_t>(pad_);
+           kPad;
   }
-  int width() const { return width_; }
-  int radius() const { return radius_; }
-  int vector_width() const { return ((width_ + kLanes - 1) / kLanes) * kLanes; }
+  int vector_width() const { return round_up(width_, kLanes); }
 
  private:
-  int width_, radius_, ring_, levels_, pad_, stride_;
+  static constexpr int kPad = 16;         // zero floats before and after each row (>= 1 + a vector's overrun)
+  static constexpr int kLineFloats = 16;  // 64-byte cache line
+  static constexpr int round_up(int n, int m) { return (n + m - 1) / m * m; }
+
+  int width_, ring_, levels_, stride_;
   std::vector<float> buffer_;
+  float* base_ = nullptr;
 };
 
 // Inverts one input row into level 0 and returns whether it holds any depth; the padding stays 0.
