@@ -82,41 +82,64 @@ struct Inversion {
   }
 };
 
-// Eight floats as one GCC/Clang vector: compiles to SSE pairs by default and to AVX where the
-// target_clones below pick it at run time. `a > b ? a : b` is exactly x86 MAXPS.
+// The dense kernel works on depth directly, "empty as +infinity", as a min filter over the bit
+// patterns of the depths (for non-negative floats, integer order is float order), so it runs on the
+// integer vector units. A depth is a key when the reference would keep it (0 < M - d <= below-M, i.e.
+// its bits lie in [lowest_key, bits(M))); every other value becomes +inf. The winner d* maps back
+// through the reference's own float operations, below_M-threshold(M - (M - d*)), which also sends
+// +inf to 0. Equal to the reference because M - d is monotone: the largest inverted value is the
+// inverted smallest depth.
+using Keys = std::int32_t __attribute__((vector_size(32)));
 using Floats = float __attribute__((vector_size(32)));
-using Mask = std::int32_t __attribute__((vector_size(32)));
 constexpr int kLanes = 8;
+constexpr std::int32_t kEmpty = 0x7F800000;  // +inf
 
 // Internal helpers, always inlined: their vector ABI never matters (-Wno-psabi for this file).
-[[gnu::always_inline]] inline Floats load(const float* p) {
-  Floats v;
+[[gnu::always_inline]] inline Keys load(const std::int32_t* p) {
+  Keys v;
   std::memcpy(&v, p, sizeof(v));
   return v;
 }
+[[gnu::always_inline]] inline Keys load(const float* p) {
+  Keys v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+}
+[[gnu::always_inline]] inline void store(std::int32_t* p, Keys v) { std::memcpy(p, &v, sizeof(v)); }
 [[gnu::always_inline]] inline void store(float* p, Floats v) { std::memcpy(p, &v, sizeof(v)); }
-[[gnu::always_inline]] inline Floats splat(float x) { return Floats{} + x; }
-[[gnu::always_inline]] inline Floats vmax(Floats a, Floats b) { return a > b ? a : b; }
+[[gnu::always_inline]] inline Keys vmin(Keys a, Keys b) { return a < b ? a : b; }
 
-// Scratch rows for one dilation: a ring of 2R+1 input rows, each with its running maxima of every
-// half-width 0..R ("levels"), padded with zeros so that widening and the vector tails never read
-// outside. Level h of a row holds max(v[x-h .. x+h]).
+// Smallest bit pattern of a depth the reference keeps: M - d must round below M.
+std::int32_t lowest_key(const Inversion& inv) {
+  std::int32_t lo = 1, hi = std::bit_cast<std::int32_t>(inv.m);  // forward(lo) == 0 < forward(hi - 1)
+  if (inv.forward(std::bit_cast<float>(lo)) > 0.0F) return lo;
+  while (hi - lo > 1) {
+    const std::int32_t mid = lo + (hi - lo) / 2;
+    if (inv.forward(std::bit_cast<float>(mid)) > 0.0F) hi = mid;
+    else lo = mid;
+  }
+  return hi;
+}
+
+// Scratch rows for one dilation: a ring of 2R+1 input rows, each with its running minima of every
+// half-width 0..R ("levels"), padded with +inf keys so that widening and the vector tails never read
+// outside. Level h of a row holds min(key[x-h .. x+h]).
 class RowRing {
  public:
   RowRing(int width, int radius)
       : width_(width), ring_(2 * radius + 1), levels_(radius + 1),
-        stride_(round_up(round_up(width, kLanes) + 2 * kPad, kLineFloats)),
+        stride_(round_up(round_up(width, kLanes) + 2 * kPad, kLineInts)),
         buffer_(static_cast<std::size_t>(ring_) * static_cast<std::size_t>(levels_) * static_cast<std::size_t>(stride_) +
-                    kLineFloats,
-                0.0F) {
+                    kLineInts,
+                kEmpty) {
     // Rows start on a cache line, so that the aligned half of the loads never straddles two lines.
-    const auto address = reinterpret_cast<std::uintptr_t>(buffer_.data());
-    base_ = buffer_.data() + (round_up(static_cast<int>(address % 64), 64) - static_cast<int>(address % 64)) / 4;
+    const auto misalignment = static_cast<int>(reinterpret_cast<std::uintptr_t>(buffer_.data()) % 64);
+    base_ = buffer_.data() + (round_up(misalignment, 64) - misalignment) / 4;
   }
   RowRing(const RowRing&) = delete;
   RowRing& operator=(const RowRing&) = delete;
 
-  float* row(int r, int level) {
+  std::int32_t* row(int r, int level) {
     return base_ +
            (static_cast<std::size_t>(r % ring_) * static_cast<std::size_t>(levels_) + static_cast<std::size_t>(level)) *
                static_cast<std::size_t>(stride_) +
@@ -125,46 +148,45 @@ class RowRing {
   int vector_width() const { return round_up(width_, kLanes); }
 
  private:
-  static constexpr int kPad = 16;         // zero floats before and after each row (>= 1 + a vector's overrun)
-  static constexpr int kLineFloats = 16;  // 64-byte cache line
+  static constexpr int kPad = 16;       // +inf keys before and after each row (>= 1 + a vector's overrun)
+  static constexpr int kLineInts = 16;  // 64-byte cache line
   static constexpr int round_up(int n, int m) { return (n + m - 1) / m * m; }
 
   int width_, ring_, levels_, stride_;
-  std::vector<float> buffer_;
-  float* base_ = nullptr;
+  std::vector<std::int32_t> buffer_;
+  std::int32_t* base_ = nullptr;
 };
 
-// Inverts one input row into level 0 and returns whether it holds any depth; the padding stays 0.
-__attribute__((target_clones("avx", "default"))) bool invert_row(const float* __restrict src, float* __restrict dst,
-                                                                  int width, float m, float threshold) {
-  const Floats vm = splat(m), vt = splat(threshold), zero{};
-  // Any set bit in a depth marks the row as used (a negative or too-far depth just costs the work).
-  Mask any{};
+// Keys of one input row into level 0; returns whether any depth is kept. The padding stays +inf.
+__attribute__((target_clones("arch=x86-64-v3", "default"))) bool key_row(const float* __restrict src,
+                                                                          std::int32_t* __restrict dst, int width,
+                                                                          std::int32_t lo, std::int32_t hi) {
+  const Keys vlo = Keys{} + lo, vhi = Keys{} + hi, empty = Keys{} + kEmpty;
+  Keys any{};
   int x = 0;
   for (; x + kLanes <= width; x += kLanes) {
-    const Floats d = load(src + x);
-    const Floats v = vm - d;
-    any |= std::bit_cast<Mask>(d);
-    // no clamp of negative v (d > M): it never outranks an empty cell's 0 and maps back to 0
-    store(dst + x, v > vt ? zero : v);
+    const Keys bits = load(src + x);
+    const Keys keep = (bits >= vlo) & (bits < vhi);  // negative depths have negative bits: dropped
+    any |= keep;
+    store(dst + x, keep ? bits : empty);
   }
   bool tail_any = false;
   for (; x < width; ++x) {
-    const float v = m - src[x];
-    dst[x] = v > threshold ? 0.0F : v;
-    tail_any |= src[x] != 0.0F;
+    const auto bits = std::bit_cast<std::int32_t>(src[x]);
+    const bool keep = bits >= lo && bits < hi;
+    dst[x] = keep ? bits : kEmpty;
+    tail_any |= keep;
   }
   for (int i = 0; i < kLanes; ++i) tail_any |= any[i] != 0;
   return tail_any;
 }
 
 // Whether a row holds any non-zero bit, stopping at the first.
-__attribute__((target_clones("avx", "default"))) bool has_depth(const float* row, int width) {
+__attribute__((target_clones("arch=x86-64-v3", "default"))) bool has_depth(const float* row, int width) {
   int x = 0;
   for (; x + 4 * kLanes <= width; x += 4 * kLanes) {
-    const Mask any = std::bit_cast<Mask>(load(row + x)) | std::bit_cast<Mask>(load(row + x + kLanes)) |
-                     std::bit_cast<Mask>(load(row + x + 2 * kLanes)) | std::bit_cast<Mask>(load(row + x + 3 * kLanes));
-    Mask zero{};
+    const Keys any = load(row + x) | load(row + x + kLanes) | load(row + x + 2 * kLanes) | load(row + x + 3 * kLanes);
+    const Keys zero{};
     if (std::memcmp(&any, &zero, sizeof(any)) != 0) return true;
   }
   for (; x < width; ++x) {
@@ -174,42 +196,43 @@ __attribute__((target_clones("avx", "default"))) bool has_depth(const float* row
 }
 
 // Level h from level h-1: the union of the windows at x-1 and x+1 (level 1 reads level 0 at x too).
-__attribute__((target_clones("avx", "default"))) void widen_row(const float* __restrict narrow, float* __restrict wide,
-                                                                 int vector_width, bool first) {
+__attribute__((target_clones("arch=x86-64-v3", "default"))) void widen_row(const std::int32_t* __restrict narrow,
+                                                                            std::int32_t* __restrict wide,
+                                                                            int vector_width, bool first) {
   if (first) {
     for (int x = 0; x < vector_width; x += kLanes)
-      store(wide + x, vmax(vmax(load(narrow + x - 1), load(narrow + x)), load(narrow + x + 1)));
+      store(wide + x, vmin(vmin(load(narrow + x - 1), load(narrow + x)), load(narrow + x + 1)));
   } else {
-    for (int x = 0; x < vector_width; x += kLanes) store(wide + x, vmax(load(narrow + x - 1), load(narrow + x + 1)));
+    for (int x = 0; x < vector_width; x += kLanes) store(wide + x, vmin(load(narrow + x - 1), load(narrow + x + 1)));
   }
 }
 
-// One output row: the max over N level rows, inverted back. N is a compile-time constant so that the
-// row pointers live in registers and the max chain is unrolled.
+// One output row: the min over N level rows, mapped back like the reference. N is a compile-time
+// constant so that the row pointers live in registers and the min chain is unrolled.
 template <int N>
-[[gnu::always_inline]] inline void combine_fixed(const float* const* sources, float* __restrict out, int width, float m,
-                                                 float threshold) {
-  const float* rows[N];
+[[gnu::always_inline]] inline void combine_fixed(const std::int32_t* const* sources, float* __restrict out, int width,
+                                                 float m, float threshold) {
+  const std::int32_t* rows[N];
   for (int s = 0; s < N; ++s) rows[s] = sources[s];
-  const Floats vm = splat(m), vt = splat(threshold), zero{};
+  const Floats vm = Floats{} + m, vt = Floats{} + threshold, zero{};
   int x = 0;
   for (; x + kLanes <= width; x += kLanes) {
-    Floats acc = load(rows[0] + x);
-    for (int s = 1; s < N; ++s) acc = vmax(acc, load(rows[s] + x));
-    const Floats d = vm - acc;
+    Keys acc = load(rows[0] + x);
+    for (int s = 1; s < N; ++s) acc = vmin(acc, load(rows[s] + x));
+    const Floats d = vm - (vm - std::bit_cast<Floats>(acc));  // +inf -> M - (-inf) = +inf -> 0 below
     store(out + x, d > vt ? zero : d);
   }
   for (; x < width; ++x) {
-    float acc = rows[0][x];
-    for (int s = 1; s < N; ++s) acc = acc > rows[s][x] ? acc : rows[s][x];
-    const float d = m - acc;
+    std::int32_t acc = rows[0][x];
+    for (int s = 1; s < N; ++s) acc = std::min(acc, rows[s][x]);
+    const float d = m - (m - std::bit_cast<float>(acc));
     out[x] = d > threshold ? 0.0F : d;
   }
 }
 
-__attribute__((target_clones("avx", "default"))) void combine_rows(const float* const* sources, int count,
-                                                                    float* __restrict out, int width, float m,
-                                                                    float threshold) {
+__attribute__((target_clones("arch=x86-64-v3", "default"))) void combine_rows(const std::int32_t* const* sources,
+                                                                               int count, float* __restrict out,
+                                                                               int width, float m, float threshold) {
   switch (count) {
     case 1: return combine_fixed<1>(sources, out, width, m, threshold);
     case 2: return combine_fixed<2>(sources, out, width, m, threshold);
@@ -224,9 +247,9 @@ __attribute__((target_clones("avx", "default"))) void combine_rows(const float* 
   }
   // kernels taller than 9 rows: a plain loop (rare, not benchmarked)
   for (int x = 0; x < width; ++x) {
-    float acc = sources[0][x];
-    for (int s = 1; s < count; ++s) acc = acc > sources[s][x] ? acc : sources[s][x];
-    const float d = m - acc;
+    std::int32_t acc = sources[0][x];
+    for (int s = 1; s < count; ++s) acc = std::min(acc, sources[s][x]);
+    const float d = m - (m - std::bit_cast<float>(acc));
     out[x] = d > threshold ? 0.0F : d;
   }
 }
@@ -243,12 +266,13 @@ void dilate_depth(const cv::Mat_<float>& sparse, const DilationOptions& options,
   if (width == 0 || height == 0) return;
   const int radius = kernel.radius();
   const Inversion inv(options.max_depth);
+  const std::int32_t lo = lowest_key(inv), hi = std::bit_cast<std::int32_t>(inv.m);
   RowRing ring(width, radius);
   std::vector<std::uint8_t> row_valid(static_cast<std::size_t>(height), 0);
 
   auto load_row = [&](int r) {
-    // Rows without any sample (the top third of a KITTI frame) are only scanned, never inverted.
-    const bool valid = has_depth(sparse[r], width) && invert_row(sparse[r], ring.row(r, 0), width, inv.m, inv.threshold);
+    // Rows without any sample (the top third of a KITTI frame) are only scanned, never converted.
+    const bool valid = has_depth(sparse[r], width) && key_row(sparse[r], ring.row(r, 0), width, lo, hi);
     row_valid[static_cast<std::size_t>(r)] = valid ? 1 : 0;
     if (!valid) return;
     for (int level = 1; level <= radius; ++level) {
@@ -257,7 +281,7 @@ void dilate_depth(const cv::Mat_<float>& sparse, const DilationOptions& options,
   };
 
   for (int r = 0; r < std::min(radius, height); ++r) load_row(r);
-  std::vector<const float*> sources;
+  std::vector<const std::int32_t*> sources;
   sources.reserve(static_cast<std::size_t>(2 * radius + 1));
   for (int y = 0; y < height; ++y) {
     if (y + radius < height) load_row(y + radius);
