@@ -261,76 +261,78 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) void combine_rows(co
   return vmin(vmin(load(k + x - 1), load(k + x)), load(k + x + 1));
 }
 
-__attribute__((target_clones("arch=x86-64-v3", "default"))) void diamond5_rows(const std::int32_t* const* k,
-                                                                                float* __restrict out0,
-                                                                                float* __restrict out1, int width,
-                                                                                float m, float threshold) {
-  const std::int32_t *k0 = k[0], *k1 = k[1], *k2 = k[2], *k3 = k[3], *k4 = k[4], *k5 = k[5];
+template <int G>
+[[gnu::always_inline]] inline void diamond5_group(const std::int32_t* const* k, float* const* out, int width, float m,
+                                                  float threshold) {
   const Floats vm = Floats{} + m, vt = Floats{} + threshold, zero{};
-  auto back = [&](Keys key) {
-    const Floats d = vm - (vm - std::bit_cast<Floats>(key));
-    return d > vt ? zero : d;
-  };
+  const std::int32_t* rows[G + 4];
+  for (int i = 0; i < G + 4; ++i) rows[i] = k[i];
   // The key rows are padded with +inf well past the last vector, so the loop may run over the end of
   // the image; only the output needs a partial store.
   for (int x = 0; x < width; x += kLanes) {
-    const Keys b1 = min3(k1, x);
-    const Keys c1 = min3(k2, x);
-    const Keys c2 = vmin(c1, vmin(load(k2 + x - 2), load(k2 + x + 2)));
-    const Keys d1 = min3(k3, x);
-    const Keys d2 = vmin(d1, vmin(load(k3 + x - 2), load(k3 + x + 2)));
-    const Keys e1 = min3(k4, x);
-    const Floats first = back(vmin(vmin(vmin(load(k0 + x), b1), vmin(c2, d1)), load(k4 + x)));
-    const int n = std::min(kLanes, width - x);
-    if (n == kLanes) {
-      store(out0 + x, first);
-    } else {
-      std::memcpy(out0 + x, &first, sizeof(float) * static_cast<std::size_t>(n));
+    Keys l0[G + 4], l1[G + 4], l2[G + 4];
+    for (int i = 0; i < G + 4; ++i) {
+      l0[i] = load(rows[i] + x);
+      if (i >= 1 && i <= G + 2) l1[i] = vmin(l0[i], vmin(load(rows[i] + x - 1), load(rows[i] + x + 1)));
+      if (i >= 2 && i <= G + 1) l2[i] = vmin(l1[i], vmin(load(rows[i] + x - 2), load(rows[i] + x + 2)));
     }
-    if (out1 != nullptr) {
-      const Floats second = back(vmin(vmin(vmin(load(k1 + x), c1), vmin(d2, e1)), load(k5 + x)));
+    const int n = std::min(kLanes, width - x);
+    for (int j = 0; j < G; ++j) {
+      if (out[j] == nullptr) continue;
+      const Keys key = vmin(vmin(vmin(l0[j], l1[j + 1]), vmin(l2[j + 2], l1[j + 3])), l0[j + 4]);
+      const Floats d = vm - (vm - std::bit_cast<Floats>(key));  // +inf -> M - (-inf) = +inf -> 0 below
+      const Floats result = d > vt ? zero : d;
       if (n == kLanes) {
-        store(out1 + x, second);
+        store(out[j] + x, result);
       } else {
-        std::memcpy(out1 + x, &second, sizeof(float) * static_cast<std::size_t>(n));
+        std::memcpy(out[j] + x, &result, sizeof(float) * static_cast<std::size_t>(n));
       }
     }
   }
 }
 
+constexpr int kDiamondGroup = 4;  // output rows per pass
+
+__attribute__((target_clones("arch=x86-64-v3", "default"))) void diamond5_rows(const std::int32_t* const* k,
+                                                                                float* const* out, int width,
+                                                                                float m, float threshold) {
+  diamond5_group<kDiamondGroup>(k, out, width, m, threshold);
+}
+
 void dilate_diamond5(const cv::Mat_<float>& sparse, const Inversion& inv, std::int32_t lo, std::int32_t hi,
                      cv::Mat_<float>& dense) {
   const int width = sparse.cols, height = sparse.rows;
-  // Key rows y-2 .. y+3 in a ring of 7, and one +inf row standing in for empty rows and rows outside
-  // the image (slot 7 of the ring is never written).
-  RowRing ring(width, 8, 1);
-  const std::int32_t* const empty = ring.row(7, 0);
+  // Key rows y-2 .. y+G+1 in a ring, and one +inf row standing in for empty rows and rows outside the
+  // image (the last slot, never written).
+  constexpr int kLive = kDiamondGroup + 4;
+  constexpr int kRing = kLive + 1;
+  RowRing ring(width, kRing + 1, 1);
+  const std::int32_t* const empty = ring.row(kRing, 0);
   std::vector<std::uint8_t> row_valid(static_cast<std::size_t>(height), 0);
   int next_row = 0;
-  auto load_until = [&](int last) {
-    for (; next_row <= std::min(last, height - 1); ++next_row) {
-      std::int32_t* slot = ring.row(next_row % 7, 0);
+  const std::int32_t* rows[kLive];
+  float* out[kDiamondGroup];
+  for (int y = 0; y < height; y += kDiamondGroup) {
+    for (; next_row <= std::min(y + kDiamondGroup + 1, height - 1); ++next_row) {
+      std::int32_t* slot = ring.row(next_row % kRing, 0);
       const bool valid = has_depth(sparse[next_row], width) && key_row(sparse[next_row], slot, width, lo, hi);
       row_valid[static_cast<std::size_t>(next_row)] = valid ? 1 : 0;
     }
-  };
-  const std::int32_t* rows[6];
-  for (int y = 0; y < height; y += 2) {
-    load_until(y + 3);
     bool any = false;
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < kLive; ++i) {
       const int r = y - 2 + i;
       const bool valid = r >= 0 && r < height && row_valid[static_cast<std::size_t>(r)] != 0;
-      rows[i] = valid ? ring.row(r % 7, 0) : empty;
+      rows[i] = valid ? ring.row(r % kRing, 0) : empty;
       any |= valid;
     }
-    float* const second = y + 1 < height ? dense[y + 1] : nullptr;
+    for (int j = 0; j < kDiamondGroup; ++j) out[j] = y + j < height ? dense[y + j] : nullptr;
     if (!any) {
-      std::memset(dense[y], 0, sizeof(float) * static_cast<std::size_t>(width));
-      if (second != nullptr) std::memset(second, 0, sizeof(float) * static_cast<std::size_t>(width));
+      for (float* row : out) {
+        if (row != nullptr) std::memset(row, 0, sizeof(float) * static_cast<std::size_t>(width));
+      }
       continue;
     }
-    diamond5_rows(rows, dense[y], second, width, inv.m, inv.threshold);
+    diamond5_rows(rows, out, width, inv.m, inv.threshold);
   }
 }
 
