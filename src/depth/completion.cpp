@@ -157,25 +157,31 @@ class RowRing {
   std::int32_t* base_ = nullptr;
 };
 
-// Keys of one input row into level 0; returns whether any depth is kept. The padding stays +inf.
+// Keys of one input row into level 0; returns whether any bit is set. The padding stays +inf.
 __attribute__((target_clones("arch=x86-64-v3", "default"))) bool key_row(const float* __restrict src,
                                                                           std::int32_t* __restrict dst, int width,
                                                                           std::int32_t lo, std::int32_t hi) {
-  const Keys vlo = Keys{} + lo, vhi = Keys{} + hi, empty = Keys{} + kEmpty;
+  // lo <= bits < hi as one unsigned comparison, (bits - lo) < (hi - lo), done signed with the sign bit
+  // flipped. Negative depths have "negative" bits: dropped.
+  using Unsigned = std::uint32_t __attribute__((vector_size(32)));
+  constexpr std::uint32_t kSign = 0x80000000U;
+  const Unsigned vlo = Unsigned{} + static_cast<std::uint32_t>(lo);
+  const Keys limit = Keys{} + std::bit_cast<std::int32_t>((static_cast<std::uint32_t>(hi) - static_cast<std::uint32_t>(lo)) ^ kSign);
+  const Keys empty = Keys{} + kEmpty;
   Keys any{};
   int x = 0;
   for (; x + kLanes <= width; x += kLanes) {
     const Keys bits = load(src + x);
-    const Keys keep = (bits >= vlo) & (bits < vhi);  // negative depths have negative bits: dropped
-    any |= keep;
-    store(dst + x, keep ? bits : empty);
+    any |= bits;
+    const Keys offset = std::bit_cast<Keys>((std::bit_cast<Unsigned>(bits) - vlo) ^ kSign);
+    store(dst + x, offset < limit ? bits : empty);
   }
   bool tail_any = false;
   for (; x < width; ++x) {
     const auto bits = std::bit_cast<std::int32_t>(src[x]);
     const bool keep = bits >= lo && bits < hi;
     dst[x] = keep ? bits : kEmpty;
-    tail_any |= keep;
+    tail_any |= bits != 0;
   }
   for (int i = 0; i < kLanes; ++i) tail_any |= any[i] != 0;
   return tail_any;
