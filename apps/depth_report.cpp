@@ -66,7 +66,7 @@ int main(int argc, char** argv) try {
   }
   cv::setNumThreads(1);
   const auto seq = data / "kitti/odometry/sequences/04";
-  const auto kitti = rgbl::read_kitti_odometry_calibration(seq / "calib.txt", 1226, 370);
+  const auto kitti = rgbl::read_kitti_odometry_calibration(seq / "calib.txt", 1226, 370);  // 04-12: 1226x370
   const auto all_poses = rgbl::read_kitti_poses(data / "kitti/odometry/poses/04.txt");
   std::vector<std::vector<rgbl::LidarPoint>> scans;
   for (int i = 0; i < frame_limit; ++i) {
@@ -101,13 +101,14 @@ int main(int argc, char** argv) try {
   stereo_settings.stereo_baseline = kitti.baseline(0, 1);
   auto stereo = rgbl::DepthSourceRegistry::with_builtins().create("stereo", stereo_settings);
 
-  std::vector<cv::Mat_<float>> dense_buffers(kernels.size(), cv::Mat_<float>(370, 1226, 0.0F));
-  for (auto& buffer : dense_buffers) buffer = cv::Mat_<float>(370, 1226, 0.0F);  // distinct buffers
+  std::vector<cv::Mat_<float>> dense_buffers(kernels.size());
+  for (auto& buffer : dense_buffers) buffer = cv::Mat_<float>(cam2.camera.height, cam2.camera.width, 0.0F);
   for (std::size_t i = 0; i < frames; ++i) {
     const cv::Mat_<float> gt = rgbl::accumulate_depth(cam2, views, poses, i, accumulation);
     gt_density += rgbl::depth_density(gt);
     rgbl::Stopwatch watch;
-    const cv::Mat_<float> sparse = rgbl::project_to_depth(views[i], cam2.P_img_lidar(), 1226, 370);
+    const cv::Mat_<float> sparse =
+        rgbl::project_to_depth(views[i], cam2.P_img_lidar(), cam2.camera.width, cam2.camera.height);
     sparse_row.ms.push_back(watch.elapsed_ms());
     sparse_row.density_sum += rgbl::depth_density(sparse);
     sparse_row.errors.add(sparse, gt);
