@@ -320,9 +320,10 @@ void dilate_diamond5(const cv::Mat_<float>& sparse, const Inversion& inv, std::i
   const std::int32_t* rows[kLive];
   float* out[kDiamondGroup];
   for (int y = 0; y < height; y += kDiamondGroup) {
+    // (no separate emptiness scan here: converting an empty row costs about as much as scanning it)
     for (; next_row <= std::min(y + kDiamondGroup + 1, height - 1); ++next_row) {
       std::int32_t* slot = ring.row(next_row % kRing, 0);
-      const bool valid = has_depth(sparse[next_row], width) && key_row(sparse[next_row], slot, width, lo, hi);
+      const bool valid = key_row(sparse[next_row], slot, width, lo, hi);
       row_valid[static_cast<std::size_t>(next_row)] = valid ? 1 : 0;
     }
     bool any = false;
