@@ -11,6 +11,16 @@
 #include <cstring>
 #include <limits>
 
+// Run-time selection of AVX2 (x86-64-v3) / AVX-512 (x86-64-v4) builds of the hot loops, with a plain
+// baseline for other CPUs. GCC on x86-64 only; elsewhere the portable code is compiled once.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define RGBL_CLONES_AVX2 __attribute__((target_clones("arch=x86-64-v3", "default")))
+#define RGBL_CLONES_AVX512 __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define RGBL_CLONES_AVX2
+#define RGBL_CLONES_AVX512
+#endif
+
 namespace rgbl {
 
 Kernel::Kernel(KernelShape shape, int size) : shape_(shape), radius_(size / 2) {
@@ -65,6 +75,7 @@ namespace {
 // The two float operations of the reference, shared by the dense and the keypoint paths so that both
 // round exactly like it: v = M - d, then anything that maps to M (empty, or too small to matter) -> 0.
 // Negative v (d > M) is clamped to 0: it can never win against an empty neighbour and maps back to 0.
+// (The keypoint lookup uses these directly; the dense kernel the equivalent key form below.)
 struct Inversion {
   float m;
   float threshold;  // largest float below M: "> threshold" means "== M" (or beyond)
@@ -158,9 +169,8 @@ class RowRing {
 };
 
 // Keys of one input row into level 0; returns whether any bit is set. The padding stays +inf.
-__attribute__((target_clones("arch=x86-64-v3", "default"))) bool key_row(const float* __restrict src,
-                                                                          std::int32_t* __restrict dst, int width,
-                                                                          std::int32_t lo, std::int32_t hi) {
+RGBL_CLONES_AVX2 bool key_row(const float* __restrict src, std::int32_t* __restrict dst, int width, std::int32_t lo,
+                              std::int32_t hi) {
   // lo <= bits < hi as one unsigned comparison, (bits - lo) < (hi - lo), done signed with the sign bit
   // flipped. Negative depths have "negative" bits: dropped.
   using Unsigned = std::uint32_t __attribute__((vector_size(32)));
@@ -188,7 +198,7 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) bool key_row(const f
 }
 
 // Whether a row holds any non-zero bit, stopping at the first.
-__attribute__((target_clones("arch=x86-64-v3", "default"))) bool has_depth(const float* row, int width) {
+RGBL_CLONES_AVX2 bool has_depth(const float* row, int width) {
   int x = 0;
   for (; x + 4 * kLanes <= width; x += 4 * kLanes) {
     const Keys any = load(row + x) | load(row + x + kLanes) | load(row + x + 2 * kLanes) | load(row + x + 3 * kLanes);
@@ -202,9 +212,8 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) bool has_depth(const
 }
 
 // Level h from level h-1: the union of the windows at x-1 and x+1 (level 1 reads level 0 at x too).
-__attribute__((target_clones("arch=x86-64-v3", "default"))) void widen_row(const std::int32_t* __restrict narrow,
-                                                                            std::int32_t* __restrict wide,
-                                                                            int vector_width, bool first) {
+RGBL_CLONES_AVX2 void widen_row(const std::int32_t* __restrict narrow, std::int32_t* __restrict wide, int vector_width,
+                                bool first) {
   if (first) {
     for (int x = 0; x < vector_width; x += kLanes)
       store(wide + x, vmin(vmin(load(narrow + x - 1), load(narrow + x)), load(narrow + x + 1)));
@@ -236,13 +245,15 @@ template <int N>
   }
 }
 
-__attribute__((target_clones("arch=x86-64-v3", "default"))) void combine_rows(const std::int32_t* const* sources,
-                                                                               int count, float* __restrict out,
-                                                                               int width, float m, float threshold) {
+RGBL_CLONES_AVX2 void combine_rows(const std::int32_t* const* sources, int count, float* __restrict out, int width,
+                                   float m, float threshold) {
   switch (count) {
-    case 1: return combine_fixed<1>(sources, out, width, m, threshold);
-    case 2: return combine_fixed<2>(sources, out, width, m, threshold);
-    case 3: return combine_fixed<3>(sources, out, width, m, threshold);
+    case 1:
+      return combine_fixed<1>(sources, out, width, m, threshold);
+    case 2:
+      return combine_fixed<2>(sources, out, width, m, threshold);
+    case 3:
+      return combine_fixed<3>(sources, out, width, m, threshold);
     case 4: return combine_fixed<4>(sources, out, width, m, threshold);
     case 5: return combine_fixed<5>(sources, out, width, m, threshold);
     case 6: return combine_fixed<6>(sources, out, width, m, threshold);
@@ -300,9 +311,8 @@ template <int G>
 
 constexpr int kDiamondGroup = 8;  // output rows per pass (4: 7% slower, 16: spills)
 
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void diamond5_rows(const std::int32_t* const* k,
-                                                                                float* const* out, int width,
-                                                                                float m, float threshold) {
+RGBL_CLONES_AVX512 void diamond5_rows(const std::int32_t* const* k, float* const* out, int width, float m,
+                                      float threshold) {
   diamond5_group<kDiamondGroup>(k, out, width, m, threshold);
 }
 
