@@ -6,9 +6,14 @@
 #include "rgbl/io/sequence.hpp"
 #include "text.hpp"
 
+#include <Eigen/SVD>
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
+#include <charconv>
 #include <cmath>
+#include <initializer_list>
 #include <numbers>
 #include <string>
 
@@ -56,17 +61,33 @@ std::vector<double> read_numbers_per_line(const fs::path& file, std::string_view
 
 // "2011-09-26 13:08:24.973999360" -> seconds since 1970-01-01 (the clock's own time zone).
 double parse_raw_timestamp(std::string_view text, const fs::path& file, std::size_t line_no) {
+  const auto tokens = detail::split(text);
+  // Fixed layout: digits at every position except the separators.
+  const auto digits = [](std::string_view t, std::initializer_list<std::size_t> separators) {
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      const bool separator = std::find(separators.begin(), separators.end(), k) != separators.end();
+      if (!separator && !std::isdigit(static_cast<unsigned char>(t[k]))) return false;
+    }
+    return true;
+  };
+  const auto number = [](std::string_view t) {
+    int v = 0;
+    std::from_chars(t.data(), t.data() + t.size(), v);
+    return v;
+  };
   int year = 0, month = 0, day = 0, hour = 0, minute = 0;
   double second = 0.0;
-  const auto tokens = detail::split(text);
-  bool ok = tokens.size() == 2 && tokens[0].size() == 10 && tokens[1].size() >= 8;
+  bool ok = tokens.size() == 2 && tokens[0].size() == 10 && tokens[1].size() >= 8 && tokens[0][4] == '-' &&
+            tokens[0][7] == '-' && tokens[1][2] == ':' && tokens[1][5] == ':' && digits(tokens[0], {4, 7}) &&
+            digits(tokens[1].substr(0, 5), {2});
   if (ok) {
-    const std::string date(tokens[0]);
-    const std::string time(tokens[1]);
-    ok = std::sscanf(date.c_str(), "%4d-%2d-%2d", &year, &month, &day) == 3 &&
-         std::sscanf(time.c_str(), "%2d:%2d:", &hour, &minute) == 2 &&
-         detail::parse_double(tokens[1].substr(6), second) && month >= 1 && month <= 12 && day >= 1 &&
-         day <= 31 && hour >= 0 && hour < 24 && minute >= 0 && minute < 60 && second >= 0.0 && second < 61.0;
+    year = number(tokens[0].substr(0, 4));
+    month = number(tokens[0].substr(5, 2));
+    day = number(tokens[0].substr(8, 2));
+    hour = number(tokens[1].substr(0, 2));
+    minute = number(tokens[1].substr(3, 2));
+    ok = detail::parse_double(tokens[1].substr(6), second) && month >= 1 && month <= 12 && day >= 1 && day <= 31 &&
+         hour < 24 && minute < 60 && second >= 0.0 && second < 61.0;
   }
   if (!ok) throw ParseError(file, line_no, "expected a timestamp 'YYYY-MM-DD hh:mm:ss.fraction'");
   // Days from civil (proleptic Gregorian).
@@ -314,7 +335,11 @@ std::unique_ptr<Sequence> open_kitti_raw(const fs::path& drive_dir, const LoadOp
       for (std::size_t i = 0; i < count; ++i) packets.push_back(read_oxts_packet(oxts_dir / fmt::format("{:010}.txt", i)));
       const auto T_imu0_imu = oxts_imu_poses(packets);
       // Rectified cam0 from the IMU: R_rect_00 * T_cam_velo (already in T_cam0_lidar) * T_velo_imu.
-      const Eigen::Isometry3d T_cam0_imu = table.calibration.T_cam0_lidar * read_kitti_rigid_transform(imu_to_velo);
+      Eigen::Isometry3d T_cam0_imu = table.calibration.T_cam0_lidar * read_kitti_rigid_transform(imu_to_velo);
+      // The calibration's 7-digit rotations are orthonormal to ~1e-7 only: project onto SO(3) so that
+      // the inverse is exact and the first pose is the identity.
+      const Eigen::JacobiSVD<Eigen::Matrix3d> svd(T_cam0_imu.linear(), Eigen::ComputeFullU | Eigen::ComputeFullV);
+      T_cam0_imu.linear() = svd.matrixU() * svd.matrixV().transpose();
       const Eigen::Isometry3d T_imu_cam0 = T_cam0_imu.inverse();
       Trajectory gt;
       gt.timestamps = times;
