@@ -27,7 +27,9 @@ class FileSequence final : public Sequence {
   const std::optional<Trajectory>& ground_truth() const override { return table_.ground_truth; }
   const std::vector<std::string>& notes() const override { return table_.notes; }
 
-  FrameInput load(std::size_t index) const override {
+  FrameInput load(std::size_t index) const override { return load(index, options_); }
+
+  FrameInput load(std::size_t index, const LoadOptions& options) const override {
     if (index >= size()) {
       throw Error(fmt::format("{}: frame {} requested, the sequence has {}", table_.path.string(), index, size()));
     }
@@ -37,19 +39,19 @@ class FileSequence final : public Sequence {
     frame.timestamp = files.timestamp;
     frame.T_world_cam0 = files.T_world_cam0;
     for (std::size_t c = 0; c < 4; ++c) {
-      if (!options_.cameras[c] || files.images[c].empty()) continue;
+      if (!options.cameras[c] || files.images[c].empty()) continue;
       if (table_.grey_from_colour && c == 0) continue;  // converted below
       frame.images[c] = read_image(files.images[c], c < 2);
       check_size(frame.images[c], files.images[c], c);
     }
-    if (table_.grey_from_colour && options_.cameras[0] && !files.images[2].empty()) {
+    if (table_.grey_from_colour && options.cameras[0] && !files.images[2].empty()) {
       cv::Mat colour = frame.images[2];
       if (colour.empty()) colour = read_image(files.images[2], false);
       check_size(colour, files.images[2], 2);
       cv::cvtColor(colour, frame.images[0], cv::COLOR_BGR2GRAY);
     }
-    if (options_.lidar && !files.scan.empty()) read_kitti_scan(files.scan, frame.scan);
-    if (options_.depth && !files.depth.empty()) frame.depth = read_depth(files.depth);
+    if (options.lidar && !files.scan.empty()) read_kitti_scan(files.scan, frame.scan);
+    if (options.depth && !files.depth.empty()) frame.depth = read_depth(files.depth);
     return frame;
   }
 

@@ -376,6 +376,9 @@ std::string_view to_string(DatasetFormat format) {
 std::unique_ptr<Sequence> open_sequence(const fs::path& dir, DatasetFormat format, const LoadOptions& options) {
   if (format == DatasetFormat::automatic) {
     std::error_code ec;
+    if (!fs::is_directory(dir, ec)) {
+      throw ParseError(dir, 0, "not a folder (expected a KITTI odometry sequence, KITTI raw drive or TUM RGB-D folder)");
+    }
     if (fs::exists(dir / "calib.txt", ec) && fs::exists(dir / "times.txt", ec)) {
       format = DatasetFormat::kitti;
     } else if (fs::is_directory(dir / "oxts", ec) || fs::is_directory(dir / "velodyne_points", ec) ||

@@ -69,6 +69,13 @@ TEST_CASE("KITTI odometry sequence 04 as the loader sees it", "[io][kitti][data]
   const auto g = lidar_seq->load(0);
   CHECK(g.grey_left().empty());
   CHECK_FALSE(g.scan.empty());
+  rgbl::LoadOptions only_right;
+  only_right.cameras = {false, true, false, false};
+  only_right.lidar = false;
+  const auto h = seq->load(1, only_right);
+  CHECK(h.grey_left().empty());
+  CHECK(h.grey_right().cols == 1226);
+  CHECK(h.scan.empty());
 }
 
 TEST_CASE("synthetic KITTI sequence loads every sensor", "[io][kitti]") {
@@ -192,6 +199,8 @@ TEST_CASE("KITTI loader: bad input names the file", "[io][kitti][bad-input]") {
                Contains("cannot open"));
     CHECK_THAT(parse_error_message([&] { rgbl::open_sequence(tmp.path()); }, tmp.path()),
                Contains("cannot tell the dataset format"));
+    CHECK_THAT(parse_error_message([&] { rgbl::open_sequence(tmp.path() / "x"); }, tmp.path() / "x"),
+               Contains("not a folder"));
     // a scan path that is a folder
     rgbl::test::SyntheticKitti kitti;
     std::filesystem::remove(kitti.scan(1));

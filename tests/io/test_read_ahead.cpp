@@ -23,6 +23,7 @@ class CountingSequence final : public rgbl::Sequence {
   double timestamp(std::size_t i) const override { return static_cast<double>(i); }
   const std::optional<rgbl::Trajectory>& ground_truth() const override { return gt_; }
   const std::vector<std::string>& notes() const override { return notes_; }
+  rgbl::FrameInput load(std::size_t i, const rgbl::LoadOptions&) const override { return load(i); }
   rgbl::FrameInput load(std::size_t i) const override {
     ++loads;
     if (i == fail_at_) throw rgbl::ParseError(fmt_path(i), 0, "broken on purpose");

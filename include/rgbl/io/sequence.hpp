@@ -62,6 +62,8 @@ class Sequence {
   // accessors (ReadAhead does). Throws ParseError naming the file that is missing, unreadable,
   // corrupt or of the wrong size.
   virtual FrameInput load(std::size_t index) const = 0;
+  // The same with other sensors than the sequence was opened with (e.g. only the scan).
+  virtual FrameInput load(std::size_t index, const LoadOptions& options) const = 0;
 };
 
 // KITTI odometry: sequences/NN with image_0..3/, velodyne/, calib.txt, times.txt; ground truth from
