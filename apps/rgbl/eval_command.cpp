@@ -145,12 +145,15 @@ int run_eval(const EvalArgs& args) {
   fmt::print("KITTI odometry metric (devkit definition: a segment every {} frames, mean over all segments)\n",
              kitti.step_size);
   fmt::print("  {:>10}  {:>8}  {:>10}  {:>16}\n", "length [m]", "segments", "t_err [%]", "r_err [deg/100m]");
+  const auto cell = [](double v, int width) {
+    return std::isfinite(v) ? fmt::format("{:>{}.4f}", v, width) : fmt::format("{:>{}}", "-", width);
+  };
   for (const auto& l : metric.per_length) {
-    fmt::print("  {:>10g}  {:>8}  {:>10.4f}  {:>16.4f}\n", l.length, l.segments, l.t_err_percent,
-               l.r_err_deg_per_100m);
+    fmt::print("  {:>10g}  {:>8}  {}  {}\n", l.length, l.segments, cell(l.t_err_percent, 10),
+               cell(l.r_err_deg_per_100m, 16));
   }
-  fmt::print("  {:>10}  {:>8}  {:>10.4f}  {:>16.4f}\n", "all", metric.segments, metric.t_err_percent,
-             metric.r_err_deg_per_100m);
+  fmt::print("  {:>10}  {:>8}  {}  {}\n", "all", metric.segments, cell(metric.t_err_percent, 10),
+             cell(metric.r_err_deg_per_100m, 16));
   if (metric.segments == 0) {
     fmt::print("  (no segment fits in the path: pass shorter --lengths)\n");
   }

@@ -26,6 +26,13 @@ void require_same_length(std::span<const Eigen::Isometry3d> estimate, std::span<
   }
 }
 
+// Relative motion from a to b. The full inverse, as the devkit computes it: with rotations read from
+// 7-digit files (orthonormal to ~1e-7 only) a transpose-inverse would leave a trace error that
+// acos((trace - 1) / 2) turns into ~1e-4 rad of spurious rotation.
+Eigen::Isometry3d between(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b) {
+  return T_a.inverse(Eigen::Affine) * T_b;
+}
+
 // The devkit's rotation error: acos of (trace - 1) / 2, clamped.
 double devkit_rotation_angle(const Eigen::Matrix3d& R) {
   const double d = 0.5 * (R(0, 0) + R(1, 1) + R(2, 2) - 1.0);
@@ -64,9 +71,8 @@ KittiMetric kitti_metric(std::span<const Eigen::Isometry3d> estimate, std::span<
       const auto it = std::upper_bound(dist.begin() + static_cast<std::ptrdiff_t>(first), dist.end(), dist[first] + L);
       if (it == dist.end()) continue;
       const auto last = static_cast<std::size_t>(it - dist.begin());
-      const Eigen::Isometry3d delta_gt = ground_truth[first].inverse() * ground_truth[last];
-      const Eigen::Isometry3d delta_est = estimate[first].inverse() * estimate[last];
-      const Eigen::Isometry3d E = delta_est.inverse() * delta_gt;
+      const Eigen::Isometry3d E = between(between(estimate[first], estimate[last]),
+                                          between(ground_truth[first], ground_truth[last]));
       KittiSegmentError s;
       s.first_frame = first;
       s.length = L;
@@ -145,9 +151,8 @@ RpeResult relative_pose_error(std::span<const Eigen::Isometry3d> estimate,
   require(delta >= 1, "delta", "at least 1 frame");
   RpeResult result;
   for (std::size_t i = 0; i + delta < estimate.size(); ++i) {
-    const Eigen::Isometry3d delta_gt = ground_truth[i].inverse() * ground_truth[i + delta];
-    const Eigen::Isometry3d delta_est = estimate[i].inverse() * estimate[i + delta];
-    const Eigen::Isometry3d E = delta_gt.inverse() * delta_est;
+    const Eigen::Isometry3d E = between(between(ground_truth[i], ground_truth[i + delta]),
+                                        between(estimate[i], estimate[i + delta]));
     result.translation_errors.push_back(E.translation().norm());
     result.rotation_errors_deg.push_back(rotation_angle(E.linear()) * kRadToDeg);
   }
@@ -165,9 +170,9 @@ DriftResult end_point_drift(std::span<const Eigen::Isometry3d> estimate,
     return d;
   }
   d.path_length = trajectory_distances(ground_truth).back();
-  const Eigen::Isometry3d delta_gt = ground_truth.front().inverse() * ground_truth.back();
-  const Eigen::Isometry3d delta_est = estimate.front().inverse() * estimate.back();
-  d.end_error = (delta_est.inverse() * delta_gt).translation().norm();
+  const Eigen::Isometry3d E = between(between(estimate.front(), estimate.back()),
+                                      between(ground_truth.front(), ground_truth.back()));
+  d.end_error = E.translation().norm();
   d.percent = d.path_length > 0.0 ? 100.0 * d.end_error / d.path_length : kNaN;
   return d;
 }

@@ -191,3 +191,18 @@ TEST_CASE("metrics: short runs, mismatched lengths and bad options", "[eval][bad
   CHECK(std::isnan(rgbl::error_stats({}).rmse));
   CHECK(rgbl::trajectory_distances(gt).back() == 50.0);
 }
+
+TEST_CASE("KITTI metric: rotations that are orthonormal to 1e-7 only give no spurious rotation error",
+          "[eval][kitti]") {
+  // Like poses read from 7-digit files: equal rotations in estimate and truth, slightly off SO(3).
+  Poses gt = arc(300, 0.003);
+  for (auto& T : gt) T.linear() += 3e-7 * Eigen::Matrix3d::Ones();
+  Poses est = gt;
+  for (auto& T : est) T.translation() *= 1.01;
+  rgbl::KittiMetricOptions options;
+  options.lengths = {100};
+  const auto m = rgbl::kitti_metric(est, gt, options);
+  CHECK(m.segments > 0);
+  CHECK(m.r_err_deg_per_100m < 1e-3);
+  CHECK(rgbl::relative_pose_error(est, gt).rotation_deg.max < 1e-4);
+}

@@ -5,7 +5,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <fstream>
+#include <limits>
 
 using Catch::Matchers::Contains;
 using Catch::Matchers::WithinAbs;
@@ -106,6 +108,20 @@ TEST_CASE("KITTI loader: bad input names the file", "[io][kitti][bad-input]") {
     const auto seq = rgbl::open_kitti_odometry(kitti.dir);
     CHECK_NOTHROW(seq->load(0));
     CHECK_THAT(parse_error_message([&] { seq->load(1); }, kitti.scan(1)), Contains("not a multiple of 16"));
+  }
+  SECTION("an empty scan and non-finite points load as they are (the depth sources skip them)") {
+    rgbl::test::SyntheticKitti kitti;
+    rgbl::test::write_bin(kitti.scan(0), {});
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    rgbl::test::write_bin(kitti.scan(1), {nan, 0.0F, 0.0F, 1.0F, inf, 1.0F, 2.0F, 0.5F, 3.0F, 4.0F, 5.0F, 0.25F});
+    const auto seq = rgbl::open_kitti_odometry(kitti.dir);
+    CHECK(seq->load(0).scan.empty());
+    const auto scan = seq->load(1).scan;
+    REQUIRE(scan.size() == 3);
+    CHECK(std::isnan(scan[0].x));
+    CHECK(std::isinf(scan[1].x));
+    CHECK(scan[2].z == 5.0F);
   }
   SECTION("missing frame in the middle") {
     rgbl::test::SyntheticKitti kitti;
