@@ -50,9 +50,9 @@ std::string detect_format(const fs::path& file) {
     }
     if (fields == 12) return "kitti";
     if (fields == 8) return "tum";
-    throw ParseError(file, line_no,
-                     fmt::format("found {} fields: expected 12 (KITTI: row-major 3x4) or 8 (TUM: t tx ty tz qx qy qz qw)",
-                                 fields));
+    throw ParseError(
+        file, line_no,
+        fmt::format("found {} fields: expected 12 (KITTI: row-major 3x4) or 8 (TUM: t tx ty tz qx qy qz qw)", fields));
   }
   throw ParseError(file, 0, "no poses in the file");
 }
@@ -72,11 +72,13 @@ std::string json_string(const std::string& text) {
   return out + "\"";
 }
 
-std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "null"; }
+std::string json_number(double v) {
+  return std::isfinite(v) ? fmt::format("{}", v) : "null";
+}
 
 std::string stats_json(const ErrorStats& s) {
-  return fmt::format(R"({{"rmse": {}, "mean": {}, "median": {}, "max": {}}})", json_number(s.rmse),
-                     json_number(s.mean), json_number(s.median), json_number(s.max));
+  return fmt::format(R"({{"rmse": {}, "mean": {}, "median": {}, "max": {}}})", json_number(s.rmse), json_number(s.mean),
+                     json_number(s.median), json_number(s.max));
 }
 
 std::string join(const std::vector<double>& v) {
@@ -98,8 +100,9 @@ int run_eval(const EvalArgs& args) {
     est = read_kitti_trajectory(args.estimate);
     gt = read_kitti_trajectory(args.ground_truth);
     if (gt.size() < est.size()) {
-      throw ParseError(args.ground_truth, 0,
-                       fmt::format("has {} poses, fewer than the {} of {}", gt.size(), est.size(), args.estimate.string()));
+      throw ParseError(
+          args.ground_truth, 0,
+          fmt::format("has {} poses, fewer than the {} of {}", gt.size(), est.size(), args.estimate.string()));
     }
     if (gt.size() > est.size()) {
       notes.push_back(fmt::format("using the first {} of the {} ground-truth poses (KITTI files pair by row)",
@@ -118,8 +121,8 @@ int run_eval(const EvalArgs& args) {
                                 e.size(), args.max_time_difference));
   }
   if (est.size() < 2) {
-    throw Error(fmt::format("{} and {}: fewer than 2 poses to compare", args.estimate.string(),
-                            args.ground_truth.string()));
+    throw Error(
+        fmt::format("{} and {}: fewer than 2 poses to compare", args.estimate.string(), args.ground_truth.string()));
   }
 
   const double path_length = trajectory_distances(gt).back();
@@ -129,9 +132,10 @@ int run_eval(const EvalArgs& args) {
     kitti.lengths = args.lengths;
   } else if (path_length <= 100.0) {
     kitti.lengths = {10, 20, 30, 40, 50, 60};
-    notes.push_back(fmt::format("the ground-truth path is {:.1f} m, too short for KITTI's 100..800 m segments: "
-                                "using 10..60 m (not comparable with published KITTI figures)",
-                                path_length));
+    notes.push_back(
+        fmt::format("the ground-truth path is {:.1f} m, too short for KITTI's 100..800 m segments: "
+                    "using 10..60 m (not comparable with published KITTI figures)",
+                    path_length));
   }
   const KittiMetric metric = kitti_metric(est, gt, kitti);
   const AteResult ate = absolute_trajectory_error(est, gt);
@@ -180,8 +184,8 @@ int run_eval(const EvalArgs& args) {
         "\"r_err_deg_per_100m\": {}, \"per_length\": [{}]}},\n"
         "  \"ate_m\": {},\n  \"rpe_translation_m\": {},\n  \"rpe_rotation_deg\": {},\n"
         "  \"drift\": {{\"end_error_m\": {}, \"percent\": {}}}\n}}\n",
-        json_string(args.estimate.generic_string()), json_string(args.ground_truth.generic_string()), est_format, est.size(),
-        json_number(path_length), join(kitti.lengths), kitti.step_size, metric.segments,
+        json_string(args.estimate.generic_string()), json_string(args.ground_truth.generic_string()), est_format,
+        est.size(), json_number(path_length), join(kitti.lengths), kitti.step_size, metric.segments,
         json_number(metric.t_err_percent), json_number(metric.r_err_deg_per_100m), per_length,
         stats_json(ate.translation), stats_json(rpe.translation), stats_json(rpe.rotation_deg),
         json_number(drift.end_error), json_number(drift.percent));
@@ -200,8 +204,8 @@ int run_eval(const EvalArgs& args) {
 
 Command add_eval_command(CLI::App& parent) {
   auto args = std::make_shared<EvalArgs>();
-  CLI::App* app = parent.add_subcommand(
-      "eval", "Compare an estimated trajectory with ground truth: KITTI metric, ATE, RPE, drift");
+  CLI::App* app =
+      parent.add_subcommand("eval", "Compare an estimated trajectory with ground truth: KITTI metric, ATE, RPE, drift");
   app->add_option("estimate", args->estimate, "Estimated trajectory (KITTI or TUM format)")->required();
   app->add_option("ground-truth", args->ground_truth, "Ground-truth trajectory in the same format")->required();
   app->add_option("--format", args->format, "Trajectory format (auto: 12 fields = kitti, 8 = tum)")

@@ -38,10 +38,11 @@ int run_info(const InfoArgs& args) {
     if (!sensors.cameras[static_cast<std::size_t>(c)]) continue;
     const CameraCalibration cam = calib.camera(c);
     const Eigen::Vector3d t = cam.T_cam_cam0.translation();
-    fmt::print("camera {}:      {:<12} {}x{}  fx {:.4f} fy {:.4f} cx {:.4f} cy {:.4f}  T_cam_cam0 t = ({:.4f}, {:.4f}, "
-               "{:.4f}) m\n",
-               c, kCameraNames[c], cam.camera.width, cam.camera.height, cam.camera.fx, cam.camera.fy, cam.camera.cx,
-               cam.camera.cy, t.x(), t.y(), t.z());
+    fmt::print(
+        "camera {}:      {:<12} {}x{}  fx {:.4f} fy {:.4f} cx {:.4f} cy {:.4f}  T_cam_cam0 t = ({:.4f}, {:.4f}, "
+        "{:.4f}) m\n",
+        c, kCameraNames[c], cam.camera.width, cam.camera.height, cam.camera.fx, cam.camera.fy, cam.camera.cx,
+        cam.camera.cy, t.x(), t.y(), t.z());
   }
   if (sensors.lidar) {
     const Eigen::Vector3d t = calib.T_cam0_lidar.translation();
@@ -50,10 +51,11 @@ int run_info(const InfoArgs& args) {
     lidar_only.cameras = {false, false, false, false};
     lidar_only.depth = false;
     const std::size_t points = seq.load(0, lidar_only).scan.size();
-    fmt::print("lidar:         {} points in frame 0; T_cam0_lidar t = ({:.4f}, {:.4f}, {:.4f}) m; cam0 sits at "
-               "({:.3f}, {:.3f}, {:.3f}) m in the LiDAR frame\n",
-               points, t.x(), t.y(), t.z(), T_lidar_cam0.translation().x(), T_lidar_cam0.translation().y(),
-               T_lidar_cam0.translation().z());
+    fmt::print(
+        "lidar:         {} points in frame 0; T_cam0_lidar t = ({:.4f}, {:.4f}, {:.4f}) m; cam0 sits at "
+        "({:.3f}, {:.3f}, {:.3f}) m in the LiDAR frame\n",
+        points, t.x(), t.y(), t.z(), T_lidar_cam0.translation().x(), T_lidar_cam0.translation().y(),
+        T_lidar_cam0.translation().z());
   } else {
     fmt::print("lidar:         none\n");
   }
@@ -79,8 +81,9 @@ int run_info(const InfoArgs& args) {
 
 Command add_info_command(CLI::App& parent) {
   auto args = std::make_shared<InfoArgs>();
-  CLI::App* app = parent.add_subcommand("info", "Show what rgbl sees in a dataset folder: frames, sensors, "
-                                                "calibration, image sizes, ground truth");
+  CLI::App* app = parent.add_subcommand("info",
+                                        "Show what rgbl sees in a dataset folder: frames, sensors, "
+                                        "calibration, image sizes, ground truth");
   app->add_option("dir", args->dir,
                   "Dataset folder: a KITTI odometry sequence (sequences/NN), a KITTI raw drive "
                   "(<date>/<date>_drive_NNNN_sync) or a TUM RGB-D folder")

@@ -20,9 +20,10 @@ constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
 void require_same_length(std::span<const Eigen::Isometry3d> estimate, std::span<const Eigen::Isometry3d> gt) {
   if (estimate.size() != gt.size()) {
-    throw Error(fmt::format("the estimate has {} poses but the ground truth has {}: they must be for the same "
-                            "frames",
-                            estimate.size(), gt.size()));
+    throw Error(
+        fmt::format("the estimate has {} poses but the ground truth has {}: they must be for the same "
+                    "frames",
+                    estimate.size(), gt.size()));
   }
 }
 
@@ -71,8 +72,8 @@ KittiMetric kitti_metric(std::span<const Eigen::Isometry3d> estimate, std::span<
       const auto it = std::upper_bound(dist.begin() + static_cast<std::ptrdiff_t>(first), dist.end(), dist[first] + L);
       if (it == dist.end()) continue;
       const auto last = static_cast<std::size_t>(it - dist.begin());
-      const Eigen::Isometry3d E = between(between(estimate[first], estimate[last]),
-                                          between(ground_truth[first], ground_truth[last]));
+      const Eigen::Isometry3d E =
+          between(between(estimate[first], estimate[last]), between(ground_truth[first], ground_truth[last]));
       KittiSegmentError s;
       s.first_frame = first;
       s.length = L;
@@ -151,8 +152,8 @@ RpeResult relative_pose_error(std::span<const Eigen::Isometry3d> estimate,
   require(delta >= 1, "delta", "at least 1 frame");
   RpeResult result;
   for (std::size_t i = 0; i + delta < estimate.size(); ++i) {
-    const Eigen::Isometry3d E = between(between(ground_truth[i], ground_truth[i + delta]),
-                                        between(estimate[i], estimate[i + delta]));
+    const Eigen::Isometry3d E =
+        between(between(ground_truth[i], ground_truth[i + delta]), between(estimate[i], estimate[i + delta]));
     result.translation_errors.push_back(E.translation().norm());
     result.rotation_errors_deg.push_back(rotation_angle(E.linear()) * kRadToDeg);
   }
@@ -170,8 +171,8 @@ DriftResult end_point_drift(std::span<const Eigen::Isometry3d> estimate,
     return d;
   }
   d.path_length = trajectory_distances(ground_truth).back();
-  const Eigen::Isometry3d E = between(between(estimate.front(), estimate.back()),
-                                      between(ground_truth.front(), ground_truth.back()));
+  const Eigen::Isometry3d E =
+      between(between(estimate.front(), estimate.back()), between(ground_truth.front(), ground_truth.back()));
   d.end_error = E.translation().norm();
   d.percent = d.path_length > 0.0 ? 100.0 * d.end_error / d.path_length : kNaN;
   return d;

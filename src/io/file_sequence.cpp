@@ -76,8 +76,9 @@ class FileSequence final : public Sequence {
     const int w = table_.calibration.width[2];
     const int h = table_.calibration.height[2];
     if (raw.cols != w || raw.rows != h) {
-      throw ParseError(file, 0, fmt::format("depth image is {}x{}, expected {}x{} like the colour images",
-                                            raw.cols, raw.rows, w, h));
+      throw ParseError(
+          file, 0,
+          fmt::format("depth image is {}x{}, expected {}x{} like the colour images", raw.cols, raw.rows, w, h));
     }
     cv::Mat_<float> depth;
     raw.convertTo(depth, CV_32F, 1.0 / table_.depth_factor);
@@ -116,9 +117,9 @@ void set_image_sizes(SequenceTable& table) {
     int& w = table.calibration.width[c];
     int& h = table.calibration.height[c];
     if (w > 0 && h > 0 && (first.cols != w || first.rows != h)) {
-      throw ParseError(file, 0,
-                       fmt::format("image is {}x{}, but the calibration says {}x{} for camera {}", first.cols,
-                                   first.rows, w, h, c));
+      throw ParseError(
+          file, 0,
+          fmt::format("image is {}x{}, but the calibration says {}x{} for camera {}", first.cols, first.rows, w, h, c));
     }
     w = first.cols;
     h = first.rows;

@@ -29,7 +29,7 @@ struct SequenceTable {
   std::vector<FrameFiles> frames;
   std::optional<Trajectory> ground_truth;
   std::vector<std::string> notes;
-  double depth_factor = 0.0;  // depth PNG units per metre
+  double depth_factor = 0.0;      // depth PNG units per metre
   bool grey_from_colour = false;  // TUM: camera 0 is the grey conversion of camera 2
 };
 

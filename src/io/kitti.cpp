@@ -115,9 +115,8 @@ std::vector<double> read_raw_timestamps(const fs::path& file) {
 
 void check_count(const fs::path& file, std::size_t rows, std::size_t frames, std::string_view what) {
   if (rows != frames) {
-    throw ParseError(file, 0,
-                     fmt::format("has {} {}, expected {} (one per frame found in the sensor folders)", rows, what,
-                                 frames));
+    throw ParseError(
+        file, 0, fmt::format("has {} {}, expected {} (one per frame found in the sensor folders)", rows, what, frames));
   }
 }
 
@@ -177,8 +176,8 @@ std::unique_ptr<Sequence> open_kitti_odometry(const fs::path& sequence_dir, cons
                        fmt::format("has {} poses, fewer than the {} frames of {}", poses.size(), count, dir.string()));
     }
     if (poses.size() > count) {
-      table.notes.push_back(fmt::format("ground truth: using the first {} of the {} poses in {}", count,
-                                        poses.size(), poses_file.string()));
+      table.notes.push_back(fmt::format("ground truth: using the first {} of the {} poses in {}", count, poses.size(),
+                                        poses_file.string()));
       poses.resize(count);
     }
     Trajectory gt;
@@ -229,10 +228,10 @@ std::vector<Eigen::Isometry3d> oxts_imu_poses(std::span<const OxtsPacket> packet
     const Eigen::Vector3d t(scale * p.lon * kDeg * kEarthRadius,
                             scale * kEarthRadius * std::log(std::tan((90.0 + p.lat) * std::numbers::pi / 360.0)),
                             p.alt);
-    const Eigen::Matrix3d R = (Eigen::AngleAxisd(p.yaw, Eigen::Vector3d::UnitZ()) *
-                               Eigen::AngleAxisd(p.pitch, Eigen::Vector3d::UnitY()) *
-                               Eigen::AngleAxisd(p.roll, Eigen::Vector3d::UnitX()))
-                                  .toRotationMatrix();
+    const Eigen::Matrix3d R =
+        (Eigen::AngleAxisd(p.yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(p.pitch, Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(p.roll, Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
     const Eigen::Isometry3d T_world_imu = make_isometry(R, t);
     if (i == 0) T_imu0_world = T_world_imu.inverse();
     poses.push_back(T_imu0_world * T_world_imu);
@@ -274,7 +273,8 @@ Eigen::Isometry3d read_kitti_rigid_transform(const fs::path& file) {
 
 std::unique_ptr<Sequence> open_kitti_raw(const fs::path& drive_dir, const LoadOptions& options) {
   const fs::path dir = normalised_dir(
-      drive_dir, "a KITTI raw drive folder (<date>_drive_NNNN_sync) with image_0x/data, velodyne_points/data, oxts/data");
+      drive_dir,
+      "a KITTI raw drive folder (<date>_drive_NNNN_sync) with image_0x/data, velodyne_points/data, oxts/data");
   const fs::path date_dir = dir.parent_path();
   detail::SequenceTable table;
   table.format = DatasetFormat::kitti_raw;
@@ -332,7 +332,8 @@ std::unique_ptr<Sequence> open_kitti_raw(const fs::path& drive_dir, const LoadOp
       detail::require_frames(oxts_dir, count, 10, ".txt");
       std::vector<OxtsPacket> packets;
       packets.reserve(count);
-      for (std::size_t i = 0; i < count; ++i) packets.push_back(read_oxts_packet(oxts_dir / fmt::format("{:010}.txt", i)));
+      for (std::size_t i = 0; i < count; ++i)
+        packets.push_back(read_oxts_packet(oxts_dir / fmt::format("{:010}.txt", i)));
       const auto T_imu0_imu = oxts_imu_poses(packets);
       // Rectified cam0 from the IMU: R_rect_00 * T_cam_velo (already in T_cam0_lidar) * T_velo_imu.
       Eigen::Isometry3d T_cam0_imu = table.calibration.T_cam0_lidar * read_kitti_rigid_transform(imu_to_velo);
@@ -365,10 +366,14 @@ DatasetFormat parse_dataset_format(std::string_view name) {
 
 std::string_view to_string(DatasetFormat format) {
   switch (format) {
-    case DatasetFormat::automatic: return "auto";
-    case DatasetFormat::kitti: return "kitti";
-    case DatasetFormat::kitti_raw: return "kitti-raw";
-    case DatasetFormat::tum: return "tum";
+    case DatasetFormat::automatic:
+      return "auto";
+    case DatasetFormat::kitti:
+      return "kitti";
+    case DatasetFormat::kitti_raw:
+      return "kitti-raw";
+    case DatasetFormat::tum:
+      return "tum";
   }
   return "unknown";
 }
@@ -377,7 +382,8 @@ std::unique_ptr<Sequence> open_sequence(const fs::path& dir, DatasetFormat forma
   if (format == DatasetFormat::automatic) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) {
-      throw ParseError(dir, 0, "not a folder (expected a KITTI odometry sequence, KITTI raw drive or TUM RGB-D folder)");
+      throw ParseError(dir, 0,
+                       "not a folder (expected a KITTI odometry sequence, KITTI raw drive or TUM RGB-D folder)");
     }
     if (fs::exists(dir / "calib.txt", ec) && fs::exists(dir / "times.txt", ec)) {
       format = DatasetFormat::kitti;
@@ -393,10 +399,14 @@ std::unique_ptr<Sequence> open_sequence(const fs::path& dir, DatasetFormat forma
     }
   }
   switch (format) {
-    case DatasetFormat::kitti: return open_kitti_odometry(dir, options);
-    case DatasetFormat::kitti_raw: return open_kitti_raw(dir, options);
-    case DatasetFormat::tum: return open_tum_rgbd(dir, {}, options);
-    case DatasetFormat::automatic: break;
+    case DatasetFormat::kitti:
+      return open_kitti_odometry(dir, options);
+    case DatasetFormat::kitti_raw:
+      return open_kitti_raw(dir, options);
+    case DatasetFormat::tum:
+      return open_tum_rgbd(dir, {}, options);
+    case DatasetFormat::automatic:
+      break;
   }
   throw ConfigError("format", "one of auto, kitti, kitti-raw, tum");
 }

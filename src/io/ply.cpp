@@ -9,7 +9,9 @@
 
 namespace rgbl {
 
-void PlyOptions::validate() const { require(camera_size > 0.0, "camera_size", "a positive size in metres"); }
+void PlyOptions::validate() const {
+  require(camera_size > 0.0, "camera_size", "a positive size in metres");
+}
 
 void write_ply(const std::filesystem::path& file, std::span<const Eigen::Vector3d> points,
                std::span<const std::array<std::uint8_t, 3>> colours_rgb,

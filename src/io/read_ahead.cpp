@@ -6,7 +6,9 @@
 
 namespace rgbl {
 
-void ReadAheadOptions::validate() const { require(depth >= 1, "read_ahead.depth", "at least 1 frame"); }
+void ReadAheadOptions::validate() const {
+  require(depth >= 1, "read_ahead.depth", "at least 1 frame");
+}
 
 ReadAhead::ReadAhead(const Sequence& sequence, const ReadAheadOptions& options)
     : sequence_(sequence), depth_(options.depth), first_(std::min(options.first, sequence.size())) {
@@ -64,7 +66,6 @@ std::optional<FrameInput> ReadAhead::next() {
   }
   changed_.notify_all();
   if (slot.error) std::rethrow_exception(slot.error);
-  ++delivered_;
   return std::move(slot.frame);
 }
 

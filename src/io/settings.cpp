@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <set>
 #include <string_view>
 
@@ -68,8 +70,8 @@ class Reader {
     std::vector<std::string> keys;
     for (auto it = root_.begin(); it != root_.end(); ++it) {
       const std::string name = (*it).name();
-      if (used_.count(name) != 0 || name.starts_with("Viewer.") || name == "File.version" ||
-          name == "Camera.type" || name == "System.SaveAtlasToFile" || name == "System.LoadAtlasFromFile") {
+      if (used_.count(name) != 0 || name.starts_with("Viewer.") || name == "File.version" || name == "Camera.type" ||
+          name == "System.SaveAtlasToFile" || name == "System.LoadAtlasFromFile") {
         continue;
       }
       keys.push_back(name);
@@ -99,8 +101,7 @@ void OrbSettings::validate() const {
   require(scale_factor > 1.0, "ORBextractor.scaleFactor", "a scale factor > 1");
   require(n_levels >= 1 && n_levels <= 32, "ORBextractor.nLevels", "1..32 pyramid levels");
   require(ini_th_fast > 0 && ini_th_fast < 256, "ORBextractor.iniThFAST", "a FAST threshold in 1..255");
-  require(min_th_fast > 0 && min_th_fast <= ini_th_fast, "ORBextractor.minThFAST",
-          "a FAST threshold in 1..iniThFAST");
+  require(min_th_fast > 0 && min_th_fast <= ini_th_fast, "ORBextractor.minThFAST", "a FAST threshold in 1..iniThFAST");
 }
 
 Settings read_settings(const std::filesystem::path& yaml) {
@@ -108,13 +109,26 @@ Settings read_settings(const std::filesystem::path& yaml) {
   if (!std::filesystem::is_regular_file(yaml, ec)) {
     throw ParseError(yaml, 0, "missing or not a file (expected an ORB-SLAM style %YAML:1.0 settings file)");
   }
+  // OpenCV insists on a "%YAML:1.0" first line; plain YAML files get it added in memory.
+  std::string text;
+  {
+    std::ifstream in(yaml, std::ios::binary);
+    if (!in) throw ParseError(yaml, 0, "cannot open (expected an ORB-SLAM style %YAML:1.0 settings file)");
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
+    throw ParseError(yaml, 0, "is empty (expected 'Key: value' settings)");
+  }
+  if (!text.starts_with("%YAML")) text = "%YAML:1.0\n" + text;
   cv::FileStorage storage;
   try {
-    storage.open(yaml.string(), cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
+    storage.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   } catch (const cv::Exception& e) {
-    throw ParseError(yaml, 0, fmt::format("not a readable %YAML:1.0 settings file ({})", e.msg));
+    throw ParseError(yaml, 0,
+                     fmt::format("not a readable YAML settings file: expected 'Key: value' lines (OpenCV: {})", e.err));
   }
-  if (!storage.isOpened()) throw ParseError(yaml, 0, "cannot open (expected an ORB-SLAM style %YAML:1.0 settings file)");
+  if (!storage.isOpened())
+    throw ParseError(yaml, 0, "cannot open (expected an ORB-SLAM style %YAML:1.0 settings file)");
   if (!storage.root().isMap()) throw ParseError(yaml, 0, "expected a map of 'Key: value' settings");
 
   Settings s;
@@ -206,13 +220,15 @@ Settings read_settings(const std::filesystem::path& yaml) {
   }
 
   if (!(s.projection.min_depth >= 0.0F)) r.fail("LiDAR.min_dist", "a distance >= 0 m");
-  if (!(s.projection.max_depth > s.projection.min_depth)) r.fail("LiDAR.max_dist", "a distance greater than LiDAR.min_dist");
+  if (!(s.projection.max_depth > s.projection.min_depth))
+    r.fail("LiDAR.max_dist", "a distance greater than LiDAR.min_dist");
   try {
     s.orb.validate();
   } catch (const ConfigError& e) {
     throw ParseError(yaml, 0, fmt::format("key '{}': {}", e.key(), e.what()));
   }
-  for (const auto& key : r.unused()) s.warnings.push_back(fmt::format("{}: unknown key '{}' ignored", yaml.string(), key));
+  for (const auto& key : r.unused())
+    s.warnings.push_back(fmt::format("{}: unknown key '{}' ignored", yaml.string(), key));
   return s;
 }
 

@@ -78,8 +78,8 @@ void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& t
       const auto& T = trajectory.poses[i];
       const Eigen::Quaterniond q(T.linear());
       const Eigen::Vector3d t = T.translation();
-      out << fmt::format("{} {} {} {} {} {} {} {}\n", trajectory.timestamps[i], t.x(), t.y(), t.z(), q.x(),
-                         q.y(), q.z(), q.w());
+      out << fmt::format("{} {} {} {} {} {} {} {}\n", trajectory.timestamps[i], t.x(), t.y(), t.z(), q.x(), q.y(),
+                         q.z(), q.w());
     }
   });
 }

@@ -49,18 +49,19 @@ std::vector<ListEntry> read_file_list(const fs::path& list, const fs::path& dir)
 }
 
 PinholeCamera camera_from_name(const std::string& name) {
-  PinholeCamera cam;
   // The published TUM RGB-D colour intrinsics per sensor (their distortion is not modelled here).
-  if (name.find("freiburg1") != std::string::npos) {
-    cam.fx = 517.3; cam.fy = 516.5; cam.cx = 318.6; cam.cy = 255.3;
-  } else if (name.find("freiburg2") != std::string::npos) {
-    cam.fx = 520.9; cam.fy = 521.0; cam.cx = 325.1; cam.cy = 249.7;
-  } else if (name.find("freiburg3") != std::string::npos) {
-    cam.fx = 535.4; cam.fy = 539.2; cam.cx = 320.1; cam.cy = 247.6;
-  } else {
-    cam.fx = 525.0; cam.fy = 525.0; cam.cx = 319.5; cam.cy = 239.5;
-  }
-  return cam;
+  const auto make = [](double fx, double fy, double cx, double cy) {
+    PinholeCamera cam;
+    cam.fx = fx;
+    cam.fy = fy;
+    cam.cx = cx;
+    cam.cy = cy;
+    return cam;
+  };
+  if (name.find("freiburg1") != std::string::npos) return make(517.3, 516.5, 318.6, 255.3);
+  if (name.find("freiburg2") != std::string::npos) return make(520.9, 521.0, 325.1, 249.7);
+  if (name.find("freiburg3") != std::string::npos) return make(535.4, 539.2, 320.1, 247.6);
+  return make(525.0, 525.0, 319.5, 239.5);  // the ROS default
 }
 
 }  // namespace

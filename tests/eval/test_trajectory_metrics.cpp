@@ -124,8 +124,8 @@ TEST_CASE("ATE: hand-computed cases", "[eval][ate]") {
   // A square of radius sqrt(2) around (5, 0, 5); the estimate is 10 % larger. The best rigid fit
   // keeps the centre and orientation, leaving every point 0.1 * sqrt(2) off.
   Poses gt, est;
-  for (const auto& c : {Eigen::Vector3d(1, 0, 1), Eigen::Vector3d(-1, 0, 1), Eigen::Vector3d(-1, 0, -1),
-                        Eigen::Vector3d(1, 0, -1)}) {
+  for (const auto& c :
+       {Eigen::Vector3d(1, 0, 1), Eigen::Vector3d(-1, 0, 1), Eigen::Vector3d(-1, 0, -1), Eigen::Vector3d(1, 0, -1)}) {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.translation() = Eigen::Vector3d(5, 0, 5) + c;
     gt.push_back(T);
@@ -157,8 +157,8 @@ TEST_CASE("perturbed ground truth: errors grow with the perturbation", "[eval][k
     // deterministic "noise": every pose shifted sideways by +-sigma
     Poses est = gt;
     for (std::size_t i = 0; i < est.size(); ++i) {
-      est[i] = est[i] * rgbl::make_isometry(Eigen::Matrix3d::Identity(),
-                                            Eigen::Vector3d(i % 2 == 0 ? sigma : -sigma, 0, 0));
+      est[i] =
+          est[i] * rgbl::make_isometry(Eigen::Matrix3d::Identity(), Eigen::Vector3d(i % 2 == 0 ? sigma : -sigma, 0, 0));
     }
     rgbl::KittiMetricOptions options;
     options.lengths = {50, 100, 200};

@@ -171,7 +171,8 @@ TEST_CASE("KITTI raw loader: missing packets, counts and sizes", "[io][kitti-raw
   SECTION("timestamps count differs") {
     SyntheticRaw raw;
     const auto file = raw.tmp.write("2011_01_01_drive_0001_sync/image_00/timestamps.txt", "2011-01-01 10:00:00.5\n");
-    CHECK_THROWS_WITH(rgbl::open_kitti_raw(raw.drive), Contains(file.string()) && Contains("has 1 timestamps, expected 3"));
+    CHECK_THROWS_WITH(rgbl::open_kitti_raw(raw.drive),
+                      Contains(file.string()) && Contains("has 1 timestamps, expected 3"));
   }
   SECTION("malformed timestamp") {
     SyntheticRaw raw;

@@ -33,8 +33,8 @@ TEST_CASE("PLY: coloured points and camera pyramids", "[io][ply]") {
   REQUIRE(lines.size() == body + 12 + 8);
   CHECK(lines[body] == "1 2 3 255 0 0");
   CHECK(lines[body + 1] == "-0.5 0.25 10 1 2 3");
-  CHECK(lines[body + 2] == "0 0 0 0 255 0");          // apex of camera 0
-  CHECK(lines[body + 7] == "0 0 5 0 255 0");          // apex of camera 1
+  CHECK(lines[body + 2] == "0 0 0 0 255 0");                       // apex of camera 0
+  CHECK(lines[body + 7] == "0 0 5 0 255 0");                       // apex of camera 1
   CHECK(lines[body + 8] == "-0.5 -0.3333333333333333 6 0 255 0");  // a base corner 1 m ahead
   CHECK(lines[body + 12] == "3 2 3 4");
   CHECK(lines[body + 19] == "3 7 11 8");

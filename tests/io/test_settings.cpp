@@ -104,7 +104,17 @@ TEST_CASE("settings: ORB-SLAM and RGB-L keys map onto rgbl values", "[io][settin
   CHECK_THAT(s.warnings[0], Contains("unknown key 'MySetting.Unknown'"));
 }
 
-TEST_CASE("settings: an empty file gives the defaults", "[io][settings]") {
+TEST_CASE("settings: ORB-SLAM3's Camera1 prefix and files without the %YAML line", "[io][settings]") {
+  rgbl::test::TempDir tmp;
+  const auto s = rgbl::read_settings(tmp.write(
+      "v1.yaml", "Camera1.fx: 500.0\nCamera1.fy: 501\nCamera1.cx: 300\nCamera1.cy: 200\nCamera1.k1: -0.25\n"));
+  REQUIRE(s.camera);
+  CHECK(s.camera->fy == 501.0);
+  CHECK(s.camera->distortion.k1 == -0.25);
+  CHECK(s.camera->width == 0);
+}
+
+TEST_CASE("settings: a minimal file gives the defaults", "[io][settings]") {
   rgbl::test::TempDir tmp;
   const auto s = rgbl::read_settings(tmp.write("min.yaml", "%YAML:1.0\nORBextractor.nFeatures: 1500\n"));
   CHECK_FALSE(s.camera);
@@ -132,11 +142,14 @@ TEST_CASE("settings: wrong types, incomplete groups and bad values name file and
              Contains("key 'LiDAR.max_dist'"));
   CHECK_THAT(error_of(tmp.write("g.yaml", replace(kRgblYaml, "KernelSize_u: 5", "KernelSize_u: 4"))),
              Contains("KernelSize_u': expected an odd kernel size"));
-  CHECK_THAT(error_of(tmp.write("h.yaml", replace(kRgblYaml, "ORBextractor.minThFAST: 7", "ORBextractor.minThFAST: 30"))),
-             Contains("ORBextractor.minThFAST"));
+  CHECK_THAT(
+      error_of(tmp.write("h.yaml", replace(kRgblYaml, "ORBextractor.minThFAST: 7", "ORBextractor.minThFAST: 30"))),
+      Contains("ORBextractor.minThFAST"));
   CHECK_THAT(error_of(tmp.write("i.yaml", replace(kRgblYaml, "LiDAR.Tr11: -1.857739385241e-03", "LiDAR.Tr11: 2.0"))),
              Contains("rotation matrix"));
   CHECK_THAT(error_of(tmp.write("j.yaml", "%YAML:1.0\nCamera.fx: [1, 2\n")), Contains("j.yaml"));
+  CHECK_THAT(error_of(tmp.write("k.yaml", "just some text\n")), Contains("not a readable YAML settings file"));
+  CHECK_THAT(error_of(tmp.write("l.yaml", "\n")), Contains("is empty"));
   CHECK_THAT(error_of(tmp.path() / "missing.yaml"), Contains("missing"));
   CHECK_THAT(error_of(tmp.path()), Contains("not a file"));
 }

@@ -67,7 +67,8 @@ TEST_CASE("TUM trajectory round trip keeps timestamps and poses", "[io][trajecto
   rgbl::test::TempDir tmp;
   rgbl::Trajectory t;
   t.poses = wiggly_poses(15);
-  for (std::size_t i = 0; i < t.poses.size(); ++i) t.timestamps.push_back(1305031102.175304 + 0.0333 * static_cast<double>(i));
+  for (std::size_t i = 0; i < t.poses.size(); ++i)
+    t.timestamps.push_back(1305031102.175304 + 0.0333 * static_cast<double>(i));
   const auto file = tmp.path() / "traj_tum.txt";
   rgbl::write_tum_trajectory(file, t);
   const auto back = rgbl::read_tum_trajectory(file);

@@ -21,7 +21,7 @@ namespace rgbl {
 
 struct KittiMetricOptions {
   std::vector<double> lengths{100, 200, 300, 400, 500, 600, 700, 800};  // m; KITTI's
-  std::size_t step_size = 10;                                          // frames between start frames
+  std::size_t step_size = 10;                                           // frames between start frames
 
   void validate() const;
 };
@@ -36,14 +36,14 @@ struct KittiSegmentError {
 struct KittiLengthError {
   double length = 0.0;
   std::size_t segments = 0;
-  double t_err_percent = 0.0;        // NaN when segments == 0
-  double r_err_deg_per_100m = 0.0;   // NaN when segments == 0
+  double t_err_percent = 0.0;       // NaN when segments == 0
+  double r_err_deg_per_100m = 0.0;  // NaN when segments == 0
 };
 
 struct KittiMetric {
-  std::size_t segments = 0;          // 0 when the run is shorter than the shortest length
-  double t_err_percent = 0.0;        // mean over all segments, %; NaN when segments == 0
-  double r_err_deg_per_100m = 0.0;   // mean over all segments, deg/100 m; NaN when segments == 0
+  std::size_t segments = 0;         // 0 when the run is shorter than the shortest length
+  double t_err_percent = 0.0;       // mean over all segments, %; NaN when segments == 0
+  double r_err_deg_per_100m = 0.0;  // mean over all segments, deg/100 m; NaN when segments == 0
   std::vector<KittiLengthError> per_length;
   std::vector<KittiSegmentError> segment_errors;
 };
@@ -70,8 +70,8 @@ AteResult absolute_trajectory_error(std::span<const Eigen::Isometry3d> estimate,
                                     std::span<const Eigen::Isometry3d> ground_truth, bool align = true);
 
 struct RpeResult {
-  ErrorStats translation;   // m per `delta` frames
-  ErrorStats rotation_deg;  // deg per `delta` frames
+  ErrorStats translation;                                       // m per `delta` frames
+  ErrorStats rotation_deg;                                      // deg per `delta` frames
   std::vector<double> translation_errors, rotation_errors_deg;  // per pair (i, i + delta)
 };
 

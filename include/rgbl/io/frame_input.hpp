@@ -20,8 +20,8 @@ struct FrameInput {
   // stereo pair (CV_8UC1), 2/3 the colour pair (CV_8UC3, BGR). TUM: the RGB camera is 2 (colour) and
   // 0 (its grey conversion).
   std::array<cv::Mat, 4> images;
-  cv::Mat_<float> depth;                      // depth camera (TUM), metres, 0 = none; empty if none
-  std::vector<LidarPoint> scan;               // LiDAR frame; empty if none
+  cv::Mat_<float> depth;                          // depth camera (TUM), metres, 0 = none; empty if none
+  std::vector<LidarPoint> scan;                   // LiDAR frame; empty if none
   std::optional<Eigen::Isometry3d> T_world_cam0;  // ground truth, when the dataset has it
 
   const cv::Mat& grey_left() const { return images[0]; }

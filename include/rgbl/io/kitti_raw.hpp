@@ -13,8 +13,8 @@
 namespace rgbl {
 
 struct OxtsPacket {
-  double lat = 0.0, lon = 0.0, alt = 0.0;       // deg, deg, m
-  double roll = 0.0, pitch = 0.0, yaw = 0.0;    // rad
+  double lat = 0.0, lon = 0.0, alt = 0.0;                   // deg, deg, m
+  double roll = 0.0, pitch = 0.0, yaw = 0.0;                // rad
   double vn = 0.0, ve = 0.0, vf = 0.0, vl = 0.0, vu = 0.0;  // m/s
 };
 

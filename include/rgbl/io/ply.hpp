@@ -14,8 +14,8 @@
 namespace rgbl {
 
 struct PlyOptions {
-  double camera_size = 0.5;                           // m
-  std::array<std::uint8_t, 3> camera_rgb{255, 0, 0};  // colour of the camera pyramids
+  double camera_size = 0.5;                              // m
+  std::array<std::uint8_t, 3> camera_rgb{255, 0, 0};     // colour of the camera pyramids
   std::array<std::uint8_t, 3> point_rgb{200, 200, 200};  // colour of points when none is given
 
   void validate() const;

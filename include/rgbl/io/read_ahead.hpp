@@ -46,7 +46,6 @@ class ReadAhead {
   std::size_t depth_;
   std::size_t first_;
   std::size_t end_;
-  std::size_t delivered_ = 0;
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<Slot> queue_;

@@ -79,9 +79,9 @@ struct TumOptions {
   // Intrinsics of the RGB camera; when unset they are taken from the folder name (freiburg1/2/3,
   // the published values without distortion) or the ROS default 525/525/319.5/239.5.
   std::optional<PinholeCamera> camera;
-  double depth_factor = 5000.0;          // depth PNG value per metre
-  double max_time_difference = 0.02;     // s, rgb/depth association
-  double max_ground_truth_gap = 0.1;     // s, longest gap between ground-truth samples to interpolate over
+  double depth_factor = 5000.0;       // depth PNG value per metre
+  double max_time_difference = 0.02;  // s, rgb/depth association
+  double max_ground_truth_gap = 0.1;  // s, longest gap between ground-truth samples to interpolate over
 
   void validate() const;
 };

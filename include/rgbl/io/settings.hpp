@@ -37,17 +37,17 @@ struct Settings {
   std::filesystem::path file;
   std::optional<PinholeCamera> camera;  // width/height 0 when the file does not give them
   std::optional<double> fps;
-  std::optional<double> bf;              // stereo baseline times fx, pixels*m
-  std::optional<bool> rgb_order;         // Camera.RGB: 1 = RGB, 0 = BGR
-  std::optional<double> th_depth;        // close/far threshold, in baselines
+  std::optional<double> bf;        // stereo baseline times fx, pixels*m
+  std::optional<bool> rgb_order;   // Camera.RGB: 1 = RGB, 0 = BGR
+  std::optional<double> th_depth;  // close/far threshold, in baselines
   std::optional<double> depth_map_factor;
   OrbSettings orb;
-  std::string lidar_method;              // e.g. "InverseDilation"; empty when absent
-  ProjectionOptions projection;          // LiDAR.min_dist, LiDAR.max_dist
+  std::string lidar_method;      // e.g. "InverseDilation"; empty when absent
+  ProjectionOptions projection;  // LiDAR.min_dist, LiDAR.max_dist
   std::optional<Eigen::Isometry3d> T_cam_lidar;
-  std::string kernel_type;               // e.g. "Diamond"; empty when absent
-  int kernel_size = 0;                   // 0 when absent
-  std::vector<std::string> warnings;     // unknown keys, one message each
+  std::string kernel_type;            // e.g. "Diamond"; empty when absent
+  int kernel_size = 0;                // 0 when absent
+  std::vector<std::string> warnings;  // unknown keys, one message each
 };
 
 // Throws ParseError naming the file (and the key) when the file cannot be read, is not a FileStorage

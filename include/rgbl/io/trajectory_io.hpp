@@ -36,7 +36,6 @@ Trajectory read_tum_trajectory(const std::filesystem::path& file);
 // Pairs (i, j) with |a[i] - b[j]| <= max_difference, chosen greedily by smallest difference as TUM's
 // associate.py does; each index used at most once; sorted by i. Both lists must be sorted ascending.
 std::vector<std::pair<std::size_t, std::size_t>> associate_timestamps(std::span<const double> a,
-                                                                      std::span<const double> b,
-                                                                      double max_difference);
+                                                                      std::span<const double> b, double max_difference);
 
 }  // namespace rgbl
