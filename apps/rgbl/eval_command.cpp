@@ -192,9 +192,16 @@ int run_eval(const EvalArgs& args) {
     if (args.json == "-") {
       fmt::print("{}", json);
     } else {
-      std::ofstream out(args.json);
-      out << json;
-      if (!out) throw Error(fmt::format("{}: cannot write the JSON report", args.json));
+      // Written whole and renamed, so that a failure never leaves a complete-looking report.
+      const std::string part = args.json + ".part";
+      {
+        std::ofstream out(part, std::ios::trunc);
+        out << json;
+        if (!out) throw Error(fmt::format("{}: cannot write the JSON report", args.json));
+      }
+      std::error_code ec;
+      fs::rename(part, args.json, ec);
+      if (ec) throw Error(fmt::format("{}: cannot write the JSON report ({})", args.json, ec.message()));
     }
   }
   return 0;
