@@ -1,0 +1,54 @@
+// rgbl: the command-line front end. Subcommands are in <name>_command.cpp (see command.hpp).
+#include "command.hpp"
+#include "rgbl/core/log.hpp"
+#include "rgbl/version.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <vector>
+
+int main(int argc, char** argv) {
+  CLI::App app{"rgbl: LiDAR-enhanced visual SLAM (RGB-L) on KITTI and TUM data, and trajectory evaluation."};
+  app.require_subcommand(1, 1);
+  app.footer("Run `rgbl <command> --help` for a command's options.");
+  app.set_version_flag("--version", RGBL_VERSION_STRING);
+  bool quiet = false;
+  app.add_flag("-q,--quiet", quiet, "Only print warnings and errors from the library");
+
+  const std::vector<rgbl::cli::Command> commands{
+      rgbl::cli::add_info_command(app),
+      rgbl::cli::add_eval_command(app),
+  };
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  auto sink = std::make_shared<spdlog::sinks::stderr_color_sink_mt>();
+  auto logger = std::make_shared<spdlog::logger>(rgbl::kLoggerName, sink);
+  logger->set_pattern("%^%l%$: %v");
+  logger->set_level(quiet ? spdlog::level::warn : spdlog::level::info);
+  rgbl::set_logger(logger);
+
+  try {
+    for (const auto& command : commands) {
+      if (command.app->parsed()) return command.run();
+    }
+    std::fputs("error: no command given (see rgbl --help)\n", stderr);
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return 1;
+  } catch (...) {
+    std::fputs("error: unknown failure\n", stderr);
+    return 1;
+  }
+}

@@ -1,0 +1,57 @@
+#pragma once
+// Settings files in ORB-SLAM's style (`%YAML:1.0`, read with OpenCV's FileStorage), including the
+// RGB-L reference's keys, mapped onto plain values. Every key is optional, but groups are all or
+// nothing: Camera.fx/fy/cx/cy, and LiDAR.Tr11..LiDAR.Tr34. Unknown keys are kept as warnings.
+//
+// Keys read (ORB-SLAM3's `Camera1.` prefix is accepted for the camera too):
+//   Camera.fx fy cx cy [k1 k2 p1 p2 k3] [width height], Camera.fps, Camera.bf, Camera.RGB,
+//   ThDepth, DepthMapFactor,
+//   ORBextractor.nFeatures scaleFactor nLevels iniThFAST minThFAST,
+//   LiDAR.Method, LiDAR.min_dist, LiDAR.max_dist, LiDAR.Tr11 .. LiDAR.Tr34 (T_cam_lidar, row-major),
+//   LiDAR.MethodInverseDilation.KernelType, LiDAR.MethodInverseDilation.KernelSize_u.
+// Viewer.* and other display-only ORB-SLAM keys are accepted and ignored without a warning.
+
+#include "rgbl/geometry/camera.hpp"
+#include "rgbl/geometry/projection.hpp"
+
+#include <Eigen/Geometry>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rgbl {
+
+struct OrbSettings {
+  int n_features = 2000;
+  double scale_factor = 1.2;
+  int n_levels = 8;
+  int ini_th_fast = 20;
+  int min_th_fast = 7;
+
+  void validate() const;
+};
+
+struct Settings {
+  std::filesystem::path file;
+  std::optional<PinholeCamera> camera;  // width/height 0 when the file does not give them
+  std::optional<double> fps;
+  std::optional<double> bf;        // stereo baseline times fx, pixels*m
+  std::optional<bool> rgb_order;   // Camera.RGB: 1 = RGB, 0 = BGR
+  std::optional<double> th_depth;  // close/far threshold, in baselines
+  std::optional<double> depth_map_factor;
+  OrbSettings orb;
+  std::string lidar_method;      // e.g. "InverseDilation"; empty when absent
+  ProjectionOptions projection;  // LiDAR.min_dist, LiDAR.max_dist
+  std::optional<Eigen::Isometry3d> T_cam_lidar;
+  std::string kernel_type;            // e.g. "Diamond"; empty when absent
+  int kernel_size = 0;                // 0 when absent
+  std::vector<std::string> warnings;  // unknown keys, one message each
+};
+
+// Throws ParseError naming the file (and the key) when the file cannot be read, is not a FileStorage
+// YAML, a value has the wrong type, a group is incomplete or a value is out of range.
+Settings read_settings(const std::filesystem::path& yaml);
+
+}  // namespace rgbl

@@ -1,0 +1,235 @@
+#include "rgbl/io/settings.hpp"
+
+#include "rgbl/core/error.hpp"
+
+#include <fmt/format.h>
+#include <opencv2/core.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <string_view>
+
+namespace rgbl {
+namespace {
+
+class Reader {
+ public:
+  Reader(std::filesystem::path file, cv::FileNode root) : file_(std::move(file)), root_(root) {}
+
+  // The first of `keys` present in the file, or an empty node.
+  std::pair<std::string, cv::FileNode> find(std::initializer_list<std::string_view> keys) {
+    for (const auto key : keys) {
+      const std::string k(key);
+      used_.insert(k);
+      cv::FileNode node = root_[k];
+      if (!node.empty() && !node.isNone()) return {k, node};
+    }
+    return {std::string(*keys.begin()), cv::FileNode()};
+  }
+
+  std::optional<double> number(std::initializer_list<std::string_view> keys) {
+    auto [key, node] = find(keys);
+    if (node.empty() || node.isNone()) return std::nullopt;
+    if (!node.isInt() && !node.isReal()) fail(key, "a number", node);
+    const double v = node.isInt() ? static_cast<double>(static_cast<int>(node)) : static_cast<double>(node);
+    if (!std::isfinite(v)) fail(key, "a finite number", node);
+    return v;
+  }
+
+  std::optional<int> integer(std::initializer_list<std::string_view> keys) {
+    auto [key, node] = find(keys);
+    if (node.empty() || node.isNone()) return std::nullopt;
+    if (node.isInt()) return static_cast<int>(node);
+    if (node.isReal()) {
+      const double v = static_cast<double>(node);
+      if (std::isfinite(v) && v == std::round(v) && std::abs(v) < 1e9) return static_cast<int>(v);
+    }
+    fail(key, "an integer", node);
+  }
+
+  std::optional<std::string> string(std::initializer_list<std::string_view> keys) {
+    auto [key, node] = find(keys);
+    if (node.empty() || node.isNone()) return std::nullopt;
+    if (!node.isString()) fail(key, "a string", node);
+    return static_cast<std::string>(node);
+  }
+
+  [[noreturn]] void fail(const std::string& key, std::string_view expected, const cv::FileNode& node) const {
+    throw ParseError(file_, 0, fmt::format("key '{}': expected {}, found {}", key, expected, describe(node)));
+  }
+  [[noreturn]] void fail(const std::string& key, std::string_view expected) const {
+    throw ParseError(file_, 0, fmt::format("key '{}': expected {}", key, expected));
+  }
+
+  // Keys of the file that were never asked for.
+  std::vector<std::string> unused() const {
+    std::vector<std::string> keys;
+    for (auto it = root_.begin(); it != root_.end(); ++it) {
+      const std::string name = (*it).name();
+      if (used_.count(name) != 0 || name.starts_with("Viewer.") || name == "File.version" || name == "Camera.type" ||
+          name == "System.SaveAtlasToFile" || name == "System.LoadAtlasFromFile") {
+        continue;
+      }
+      keys.push_back(name);
+    }
+    return keys;
+  }
+
+ private:
+  static std::string describe(const cv::FileNode& node) {
+    if (node.isString()) return fmt::format("the string '{}'", static_cast<std::string>(node));
+    if (node.isSeq()) return "a sequence";
+    if (node.isMap()) return "a map";
+    if (node.isInt()) return fmt::format("the integer {}", static_cast<int>(node));
+    if (node.isReal()) return fmt::format("the number {}", static_cast<double>(node));
+    return "something else";
+  }
+
+  std::filesystem::path file_;
+  cv::FileNode root_;
+  std::set<std::string> used_;
+};
+
+}  // namespace
+
+void OrbSettings::validate() const {
+  require(n_features > 0, "ORBextractor.nFeatures", "a positive number of features");
+  require(scale_factor > 1.0, "ORBextractor.scaleFactor", "a scale factor > 1");
+  require(n_levels >= 1 && n_levels <= 32, "ORBextractor.nLevels", "1..32 pyramid levels");
+  require(ini_th_fast > 0 && ini_th_fast < 256, "ORBextractor.iniThFAST", "a FAST threshold in 1..255");
+  require(min_th_fast > 0 && min_th_fast <= ini_th_fast, "ORBextractor.minThFAST", "a FAST threshold in 1..iniThFAST");
+}
+
+Settings read_settings(const std::filesystem::path& yaml) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(yaml, ec)) {
+    throw ParseError(yaml, 0, "missing or not a file (expected an ORB-SLAM style %YAML:1.0 settings file)");
+  }
+  // OpenCV insists on a "%YAML:1.0" first line; plain YAML files get it added in memory.
+  std::string text;
+  {
+    std::ifstream in(yaml, std::ios::binary);
+    if (!in) throw ParseError(yaml, 0, "cannot open (expected an ORB-SLAM style %YAML:1.0 settings file)");
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
+    throw ParseError(yaml, 0, "is empty (expected 'Key: value' settings)");
+  }
+  if (!text.starts_with("%YAML")) text = "%YAML:1.0\n" + text;
+  cv::FileStorage storage;
+  try {
+    storage.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  } catch (const cv::Exception& e) {
+    throw ParseError(yaml, 0,
+                     fmt::format("not a readable YAML settings file: expected 'Key: value' lines (OpenCV: {})", e.err));
+  }
+  if (!storage.isOpened())
+    throw ParseError(yaml, 0, "cannot open (expected an ORB-SLAM style %YAML:1.0 settings file)");
+  if (!storage.root().isMap()) throw ParseError(yaml, 0, "expected a map of 'Key: value' settings");
+
+  Settings s;
+  s.file = yaml;
+  Reader r(yaml, storage.root());
+
+  // Camera: fx fy cx cy all or none; "Camera1." is ORB-SLAM3's newer spelling.
+  const auto cam_key = [](std::string_view name) {
+    return std::array<std::string, 2>{fmt::format("Camera.{}", name), fmt::format("Camera1.{}", name)};
+  };
+  std::array<std::optional<double>, 4> intrinsics;
+  const std::array<std::string_view, 4> names{"fx", "fy", "cx", "cy"};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const auto keys = cam_key(names[k]);
+    intrinsics[k] = r.number({keys[0], keys[1]});
+  }
+  const auto given = std::count_if(intrinsics.begin(), intrinsics.end(), [](const auto& v) { return v.has_value(); });
+  if (given != 0 && given != 4) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (!intrinsics[k]) r.fail(cam_key(names[k])[0], "a number (Camera.fx, fy, cx, cy come together)");
+    }
+  }
+  if (given == 4) {
+    PinholeCamera cam;
+    cam.fx = *intrinsics[0];
+    cam.fy = *intrinsics[1];
+    cam.cx = *intrinsics[2];
+    cam.cy = *intrinsics[3];
+    const auto read_distortion = [&](std::string_view name, double& out) {
+      const auto keys = cam_key(name);
+      if (const auto v = r.number({keys[0], keys[1]})) out = *v;
+    };
+    read_distortion("k1", cam.distortion.k1);
+    read_distortion("k2", cam.distortion.k2);
+    read_distortion("p1", cam.distortion.p1);
+    read_distortion("p2", cam.distortion.p2);
+    read_distortion("k3", cam.distortion.k3);
+    if (const auto w = r.integer({"Camera.width", "Camera1.width"})) cam.width = *w;
+    if (const auto h = r.integer({"Camera.height", "Camera1.height"})) cam.height = *h;
+    if (!(cam.fx > 0.0 && cam.fy > 0.0)) r.fail("Camera.fx", "positive focal lengths (Camera.fx, Camera.fy)");
+    if (cam.width < 0 || cam.height < 0) r.fail("Camera.width", "a non-negative image size");
+    s.camera = cam;
+  }
+  s.fps = r.number({"Camera.fps"});
+  s.bf = r.number({"Camera.bf", "Stereo.b"});
+  if (const auto rgb = r.integer({"Camera.RGB"})) {
+    if (*rgb != 0 && *rgb != 1) r.fail("Camera.RGB", "0 (BGR) or 1 (RGB)");
+    s.rgb_order = *rgb == 1;
+  }
+  s.th_depth = r.number({"ThDepth", "Stereo.ThDepth"});
+  s.depth_map_factor = r.number({"DepthMapFactor", "RGBD.DepthMapFactor"});
+
+  if (const auto v = r.integer({"ORBextractor.nFeatures"})) s.orb.n_features = *v;
+  if (const auto v = r.number({"ORBextractor.scaleFactor"})) s.orb.scale_factor = *v;
+  if (const auto v = r.integer({"ORBextractor.nLevels"})) s.orb.n_levels = *v;
+  if (const auto v = r.integer({"ORBextractor.iniThFAST"})) s.orb.ini_th_fast = *v;
+  if (const auto v = r.integer({"ORBextractor.minThFAST"})) s.orb.min_th_fast = *v;
+
+  if (const auto v = r.string({"LiDAR.Method"})) s.lidar_method = *v;
+  if (const auto v = r.number({"LiDAR.min_dist"})) s.projection.min_depth = static_cast<float>(*v);
+  if (const auto v = r.number({"LiDAR.max_dist"})) s.projection.max_depth = static_cast<float>(*v);
+  std::array<std::optional<double>, 12> tr;
+  int tr_given = 0;
+  for (int k = 0; k < 12; ++k) {
+    tr[static_cast<std::size_t>(k)] = r.number({fmt::format("LiDAR.Tr{}{}", k / 4 + 1, k % 4 + 1)});
+    tr_given += tr[static_cast<std::size_t>(k)] ? 1 : 0;
+  }
+  if (tr_given != 0 && tr_given != 12) {
+    for (int k = 0; k < 12; ++k) {
+      if (!tr[static_cast<std::size_t>(k)]) {
+        r.fail(fmt::format("LiDAR.Tr{}{}", k / 4 + 1, k % 4 + 1), "a number (LiDAR.Tr11..LiDAR.Tr34 come together)");
+      }
+    }
+  }
+  if (tr_given == 12) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    for (int k = 0; k < 12; ++k) T.matrix()(k / 4, k % 4) = *tr[static_cast<std::size_t>(k)];
+    const Eigen::Matrix3d R = T.linear();
+    if ((R * R.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-3 ||
+        std::abs(R.determinant() - 1.0) > 1e-3) {
+      r.fail("LiDAR.Tr11", "LiDAR.Tr11..Tr33 to form a rotation matrix");
+    }
+    s.T_cam_lidar = T;
+  }
+  if (const auto v = r.string({"LiDAR.MethodInverseDilation.KernelType"})) s.kernel_type = *v;
+  if (const auto v = r.integer({"LiDAR.MethodInverseDilation.KernelSize_u"})) {
+    if (*v < 1 || *v % 2 == 0) r.fail("LiDAR.MethodInverseDilation.KernelSize_u", "an odd kernel size >= 1");
+    s.kernel_size = *v;
+  }
+
+  if (!(s.projection.min_depth >= 0.0F)) r.fail("LiDAR.min_dist", "a distance >= 0 m");
+  if (!(s.projection.max_depth > s.projection.min_depth))
+    r.fail("LiDAR.max_dist", "a distance greater than LiDAR.min_dist");
+  try {
+    s.orb.validate();
+  } catch (const ConfigError& e) {
+    throw ParseError(yaml, 0, fmt::format("key '{}': {}", e.key(), e.what()));
+  }
+  for (const auto& key : r.unused())
+    s.warnings.push_back(fmt::format("{}: unknown key '{}' ignored", yaml.string(), key));
+  return s;
+}
+
+}  // namespace rgbl

@@ -1,0 +1,92 @@
+#include "text.hpp"
+
+#include "rgbl/core/error.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <system_error>
+
+namespace rgbl::detail {
+
+bool parse_double(std::string_view token, double& out) {
+  if (token.empty()) return false;
+  const char* end = token.data() + token.size();
+  const auto result = std::from_chars(token.data(), end, out);
+  return result.ec == std::errc() && result.ptr == end;
+}
+
+std::vector<std::string_view> split(std::string_view line) {
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  std::vector<std::string_view> tokens;
+  std::size_t pos = 0;
+  while (pos < line.size()) {
+    const auto start = line.find_first_not_of(" \t,", pos);
+    if (start == std::string_view::npos) break;
+    const auto stop = std::min(line.find_first_of(" \t,", start), line.size());
+    tokens.push_back(line.substr(start, stop - start));
+    pos = stop;
+  }
+  return tokens;
+}
+
+bool is_comment_or_blank(std::string_view line) {
+  const auto start = line.find_first_not_of(" \t\r");
+  return start == std::string_view::npos || line[start] == '#';
+}
+
+std::ifstream open_for_reading(const std::filesystem::path& file, std::string_view what) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) {
+    throw ParseError(file, 0, fmt::format("is a directory (expected {})", what));
+  }
+  std::ifstream in(file);
+  if (!in) throw ParseError(file, 0, fmt::format("cannot open the file (expected {})", what));
+  return in;
+}
+
+void write_atomically(const std::filesystem::path& file, const std::function<void(std::ofstream&)>& write) {
+  auto tmp = file;
+  tmp += ".part";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(fmt::format("{}: cannot open for writing", file.string()));
+    write(out);
+    out.flush();
+    if (!out) {
+      out.close();
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      throw Error(fmt::format("{}: write failed (disk full?)", file.string()));
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, file, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw Error(fmt::format("{}: cannot move the finished file into place", file.string()));
+  }
+}
+
+std::vector<std::size_t> numbered_files(const std::filesystem::path& dir, std::string_view extension) {
+  std::vector<std::size_t> indices;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const auto name = entry.path().filename().string();
+    if (name.size() <= extension.size() || !name.ends_with(extension)) continue;
+    const std::string_view stem(name.data(), name.size() - extension.size());
+    if (!std::all_of(stem.begin(), stem.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
+      continue;
+    }
+    std::size_t index = 0;
+    const auto result = std::from_chars(stem.data(), stem.data() + stem.size(), index);
+    if (result.ec == std::errc()) indices.push_back(index);
+  }
+  if (ec) throw ParseError(dir, 0, fmt::format("cannot list the folder: {}", ec.message()));
+  std::sort(indices.begin(), indices.end());
+  return indices;
+}
+
+}  // namespace rgbl::detail

@@ -1,0 +1,30 @@
+#pragma once
+// Helpers shared by io's text parsers and writers (internal).
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace rgbl::detail {
+
+// Whole-token double; accepts what std::from_chars accepts (no leading '+', no "inf"/"nan" check).
+bool parse_double(std::string_view token, double& out);
+// Whitespace-separated tokens of a line (a trailing '\r' is dropped).
+std::vector<std::string_view> split(std::string_view line);
+// True for blank lines and '#' comments.
+bool is_comment_or_blank(std::string_view line);
+
+// Opens a text file for reading or throws ParseError(file, 0, "cannot open ... (expected <what>)").
+std::ifstream open_for_reading(const std::filesystem::path& file, std::string_view what);
+
+// Calls write(stream) on a temporary file next to `file`, then renames it into place; on failure
+// removes the temporary and throws Error naming `file`.
+void write_atomically(const std::filesystem::path& file, const std::function<void(std::ofstream&)>& write);
+
+// Sorted indices of files named <digits><extension> in `dir`, keyed by their number.
+std::vector<std::size_t> numbered_files(const std::filesystem::path& dir, std::string_view extension);
+
+}  // namespace rgbl::detail

@@ -1,0 +1,28 @@
+# A malformed trajectory must give a non-zero exit code and an "error: <file>:<line>: ..." message,
+# without a stack trace; so must a missing file.
+file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${WORK_DIR})
+file(WRITE ${WORK_DIR}/gt.txt "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 1\n1 0 0 0 0 1 0 0 0 0 1 2\n")
+file(WRITE ${WORK_DIR}/est4.txt "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 1\n1 0 0 0 0 1 0 0 0 0 1 2\n1 0 0 0 0 1 0 0 0 0 1 3\n")
+file(WRITE ${WORK_DIR}/bad.txt "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1\n1 0 0 0 0 1 0 0 0 0 1 2\n")
+
+function(expect_failure expected)
+  execute_process(COMMAND ${RGBL} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  message("exit ${rc}: ${err}")
+  if(rc EQUAL 0)
+    message(FATAL_ERROR "rgbl ${ARGN} succeeded")
+  endif()
+  if(NOT err MATCHES "^error: " OR NOT err MATCHES "${expected}")
+    message(FATAL_ERROR "stderr does not start with 'error: ' or lacks '${expected}'")
+  endif()
+  if(err MATCHES "terminate called|Aborted|what\\(\\)")
+    message(FATAL_ERROR "looks like a crash")
+  endif()
+endfunction()
+
+expect_failure("bad\\.txt:2: expected 12 numbers" eval ${WORK_DIR}/bad.txt ${WORK_DIR}/gt.txt --format kitti)
+expect_failure("bad\\.txt:2: expected 12 numbers" eval ${WORK_DIR}/gt.txt ${WORK_DIR}/bad.txt)
+file(WRITE ${WORK_DIR}/odd.txt "# five fields\n1 2 3 4 5\n")
+expect_failure("odd\\.txt:2: found 5 fields: expected 12 \\(KITTI" eval ${WORK_DIR}/odd.txt ${WORK_DIR}/gt.txt)
+expect_failure("missing\\.txt: cannot open" eval ${WORK_DIR}/missing.txt ${WORK_DIR}/gt.txt)
+expect_failure("gt\\.txt: has 3 poses, fewer than the 4" eval ${WORK_DIR}/est4.txt ${WORK_DIR}/gt.txt)

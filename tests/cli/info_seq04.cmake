@@ -1,0 +1,17 @@
+# `rgbl info` on the real KITTI excerpt: what the loader sees.
+set(dir ${DATA_DIR}/kitti/odometry/sequences/04)
+if(NOT EXISTS ${dir})
+  message("skipped: no data (${dir} not found)")
+  return()
+endif()
+execute_process(COMMAND ${RGBL} info ${dir} --check RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}${err}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "rgbl info failed with ${rc}")
+endif()
+foreach(expected "frames: +51 " "camera 0: +grey left +1226x370 +fx 707\\.0912" "camera 2: +colour left +1226x370"
+                 "lidar: +[0-9]+ points" "ground truth: +51 poses" "first 51 of the 271 poses" "all 51 frames load")
+  if(NOT out MATCHES "${expected}")
+    message(FATAL_ERROR "output does not match '${expected}'")
+  endif()
+endforeach()

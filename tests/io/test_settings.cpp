@@ -1,0 +1,155 @@
+#include "rgbl/core/error.hpp"
+#include "rgbl/io/settings.hpp"
+#include "support/temp_dir.hpp"
+
+#include <catch2/catch.hpp>
+
+using Catch::Matchers::Contains;
+
+namespace {
+
+// Shaped like the RGB-L reference's KITTI04-12.yaml (values of sequence 04).
+const char* kRgblYaml = R"(%YAML:1.0
+File.version: "1.0"
+Camera.type: "PinHole"
+Camera.fx: 707.0912
+Camera.fy: 707.0912
+Camera.cx: 601.8873
+Camera.cy: 183.1104
+Camera.k1: 0.0
+Camera.k2: 0.0
+Camera.p1: 0.0
+Camera.p2: 0.0
+Camera.width: 1226
+Camera.height: 370
+Camera.fps: 10.0
+Camera.bf: 379.8145
+Camera.RGB: 1
+ThDepth: 40.0
+DepthMapFactor: 1.0
+ORBextractor.nFeatures: 2000
+ORBextractor.scaleFactor: 1.2
+ORBextractor.nLevels: 8
+ORBextractor.iniThFAST: 20
+ORBextractor.minThFAST: 7
+LiDAR.Method: "InverseDilation"
+LiDAR.min_dist: 5.0
+LiDAR.max_dist: 200.0
+LiDAR.Tr11: -1.857739385241e-03
+LiDAR.Tr12: -9.999659513510e-01
+LiDAR.Tr13: -8.039975204516e-03
+LiDAR.Tr14: -4.784029760483e-03
+LiDAR.Tr21: -6.481465826011e-03
+LiDAR.Tr22: 8.051860151134e-03
+LiDAR.Tr23: -9.999466081774e-01
+LiDAR.Tr24: -7.337429464231e-02
+LiDAR.Tr31: 9.999773098287e-01
+LiDAR.Tr32: -1.805528627661e-03
+LiDAR.Tr33: -6.496203536139e-03
+LiDAR.Tr34: -3.339968064433e-01
+LiDAR.MethodInverseDilation.KernelType: "Diamond"
+LiDAR.MethodInverseDilation.KernelSize_u: 5
+Viewer.KeyFrameSize: 0.6
+MySetting.Unknown: 3
+)";
+
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const auto pos = text.find(from);
+  REQUIRE(pos != std::string::npos);
+  return text.replace(pos, from.size(), to);
+}
+
+std::string error_of(const std::filesystem::path& file) {
+  try {
+    rgbl::read_settings(file);
+  } catch (const rgbl::ParseError& e) {
+    CHECK(e.file() == file);
+    return e.what();
+  }
+  FAIL("no ParseError for " << file.string());
+  return {};
+}
+
+}  // namespace
+
+TEST_CASE("settings: ORB-SLAM and RGB-L keys map onto rgbl values", "[io][settings]") {
+  rgbl::test::TempDir tmp;
+  const auto s = rgbl::read_settings(tmp.write("kitti04.yaml", kRgblYaml));
+  REQUIRE(s.camera);
+  CHECK(s.camera->fx == 707.0912);
+  CHECK(s.camera->cy == 183.1104);
+  CHECK(s.camera->width == 1226);
+  CHECK(s.camera->height == 370);
+  CHECK(s.camera->distortion.is_zero());
+  CHECK(s.fps == 10.0);
+  CHECK(s.bf == 379.8145);
+  CHECK(s.rgb_order == true);
+  CHECK(s.th_depth == 40.0);
+  CHECK(s.depth_map_factor == 1.0);
+  CHECK(s.orb.n_features == 2000);
+  CHECK(s.orb.scale_factor == 1.2);
+  CHECK(s.orb.n_levels == 8);
+  CHECK(s.orb.ini_th_fast == 20);
+  CHECK(s.orb.min_th_fast == 7);
+  CHECK(s.lidar_method == "InverseDilation");
+  CHECK(s.projection.min_depth == 5.0F);
+  CHECK(s.projection.max_depth == 200.0F);
+  REQUIRE(s.T_cam_lidar);
+  CHECK(s.T_cam_lidar->matrix()(0, 1) == -9.999659513510e-01);
+  CHECK(s.T_cam_lidar->matrix()(2, 3) == -3.339968064433e-01);
+  CHECK(s.T_cam_lidar->matrix().row(3) == Eigen::RowVector4d(0, 0, 0, 1));
+  CHECK(s.kernel_type == "Diamond");
+  CHECK(s.kernel_size == 5);
+  REQUIRE(s.warnings.size() == 1);  // Viewer.* and File.version are known ORB-SLAM keys
+  CHECK_THAT(s.warnings[0], Contains("unknown key 'MySetting.Unknown'"));
+}
+
+TEST_CASE("settings: ORB-SLAM3's Camera1 prefix and files without the %YAML line", "[io][settings]") {
+  rgbl::test::TempDir tmp;
+  const auto s = rgbl::read_settings(tmp.write(
+      "v1.yaml", "Camera1.fx: 500.0\nCamera1.fy: 501\nCamera1.cx: 300\nCamera1.cy: 200\nCamera1.k1: -0.25\n"));
+  REQUIRE(s.camera);
+  CHECK(s.camera->fy == 501.0);
+  CHECK(s.camera->distortion.k1 == -0.25);
+  CHECK(s.camera->width == 0);
+}
+
+TEST_CASE("settings: a minimal file gives the defaults", "[io][settings]") {
+  rgbl::test::TempDir tmp;
+  const auto s = rgbl::read_settings(tmp.write("min.yaml", "%YAML:1.0\nORBextractor.nFeatures: 1500\n"));
+  CHECK_FALSE(s.camera);
+  CHECK_FALSE(s.T_cam_lidar);
+  CHECK(s.orb.n_features == 1500);
+  CHECK(s.orb.n_levels == 8);
+  CHECK(s.projection.min_depth == 5.0F);
+  CHECK(s.kernel_size == 0);
+  CHECK(s.warnings.empty());
+}
+
+TEST_CASE("settings: wrong types, incomplete groups and bad values name file and key", "[io][settings][bad-input]") {
+  rgbl::test::TempDir tmp;
+  CHECK_THAT(error_of(tmp.write("a.yaml", replace(kRgblYaml, "LiDAR.min_dist: 5.0", "LiDAR.min_dist: \"five\""))),
+             Contains("key 'LiDAR.min_dist': expected a number, found the string 'five'"));
+  CHECK_THAT(error_of(tmp.write("b.yaml", replace(kRgblYaml, "ORBextractor.nLevels: 8", "ORBextractor.nLevels: 8.5"))),
+             Contains("key 'ORBextractor.nLevels': expected an integer"));
+  CHECK_THAT(error_of(tmp.write("c.yaml", replace(kRgblYaml, "Camera.cy: 183.1104\n", ""))),
+             Contains("key 'Camera.cy'"));
+  CHECK_THAT(error_of(tmp.write("d.yaml", replace(kRgblYaml, "LiDAR.Tr23: -9.999466081774e-01\n", ""))),
+             Contains("key 'LiDAR.Tr23'"));
+  CHECK_THAT(error_of(tmp.write("e.yaml", replace(kRgblYaml, "LiDAR.Method: \"InverseDilation\"", "LiDAR.Method: 3"))),
+             Contains("key 'LiDAR.Method': expected a string"));
+  CHECK_THAT(error_of(tmp.write("f.yaml", replace(kRgblYaml, "LiDAR.max_dist: 200.0", "LiDAR.max_dist: 2.0"))),
+             Contains("key 'LiDAR.max_dist'"));
+  CHECK_THAT(error_of(tmp.write("g.yaml", replace(kRgblYaml, "KernelSize_u: 5", "KernelSize_u: 4"))),
+             Contains("KernelSize_u': expected an odd kernel size"));
+  CHECK_THAT(
+      error_of(tmp.write("h.yaml", replace(kRgblYaml, "ORBextractor.minThFAST: 7", "ORBextractor.minThFAST: 30"))),
+      Contains("ORBextractor.minThFAST"));
+  CHECK_THAT(error_of(tmp.write("i.yaml", replace(kRgblYaml, "LiDAR.Tr11: -1.857739385241e-03", "LiDAR.Tr11: 2.0"))),
+             Contains("rotation matrix"));
+  CHECK_THAT(error_of(tmp.write("j.yaml", "%YAML:1.0\nCamera.fx: [1, 2\n")), Contains("j.yaml"));
+  CHECK_THAT(error_of(tmp.write("k.yaml", "just some text\n")), Contains("not a readable YAML settings file"));
+  CHECK_THAT(error_of(tmp.write("l.yaml", "\n")), Contains("is empty"));
+  CHECK_THAT(error_of(tmp.path() / "missing.yaml"), Contains("missing"));
+  CHECK_THAT(error_of(tmp.path()), Contains("not a file"));
+}
