@@ -78,10 +78,12 @@ DrivePath::DrivePath(const PathOptions& options, double length) {
       const double corners = 2.0 * std::numbers::pi * radius;
       require(length >= corners, "path.loop_corner_radius",
               "a corner radius whose full circle (2 pi r) fits into the loop's length");
+      // Start and end halfway along a side, so that the car comes back to the start on a straight.
       const double side = (length - corners) / 4.0;
+      if (side > 0.0) segments_.push_back({0.5 * side, 0.0});
       for (int i = 0; i < 4; ++i) {
-        if (side > 0.0) segments_.push_back({side, 0.0});
         segments_.push_back({corners / 4.0, 1.0 / radius});
+        if (side > 0.0) segments_.push_back({i < 3 ? side : 0.5 * side, 0.0});
       }
       closed_ = true;
       break;

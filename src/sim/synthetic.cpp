@@ -182,11 +182,12 @@ Rgb shade(const StreetScene& scene, const std::optional<RayHit>& hit, const Eige
   const SurfacePoint s = scene.surface(*hit, origin, d);
   const double len = d.norm();
   const double cos_incidence = std::max(std::abs(s.normal.dot(d)) / len, 0.05);
-  // Four samples per pixel: each stands for half a pixel; the long axis of the footprint decides.
-  const double footprint = blank ? kInf : 0.5 * hit->t * len * pixel_angle / cos_incidence;
+  // Four samples per pixel: each stands for half a pixel. A slanted surface stretches the footprint
+  // along one axis only: take the geometric mean of its two axes.
+  const double footprint = blank ? kInf : 0.5 * hit->t * len * pixel_angle / std::sqrt(cos_incidence);
   const Rgb a = sim_detail::albedo(s, footprint);
   static const Eigen::Vector3d kSun = Eigen::Vector3d(0.35, -0.85, 0.40).normalized();
-  const auto light = static_cast<float>(0.55 + 0.5 * std::max(0.0, s.normal.dot(kSun)));
+  const auto light = static_cast<float>(0.7 + 0.4 * std::max(0.0, s.normal.dot(kSun)));
   return {a.r * light, a.g * light, a.b * light};
 }
 

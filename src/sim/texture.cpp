@@ -102,8 +102,9 @@ Rgb pick(const Rgb (&palette)[N], std::uint32_t h) {
 Rgb road(const SurfacePoint& s, double fp) {
   float g = 0.31F + 0.07F * fbm(s.u, s.v, 3.0, 6, 11U, fp);
   g += 0.07F * rects(s.u, s.v, 2.7, 0.35F, 12U, fp).value();         // repair patches
-  g += 0.07F * rects(s.u + 0.37, s.v + 1.1, 0.8, 0.3F, 13U, fp).value();  // stains
-  g += 0.09F * rects(s.u, s.v, 0.23, 0.22F, 14U, fp).value();        // chips and gravel
+  g += 0.10F * rects(s.u + 0.37, s.v + 1.1, 0.8, 0.3F, 13U, fp).value();  // stains
+  g += 0.16F * rects(s.u, s.v, 0.23, 0.25F, 14U, fp).value();         // chips and gravel
+  g += 0.14F * rects(s.u + 0.05, s.v + 0.11, 0.13, 0.2F, 15U, fp).value();
   return {g * 1.01F, g, g * 0.96F};
 }
 
@@ -119,7 +120,7 @@ Rgb sidewalk(const SurfacePoint& s, double fp) {
   const std::int32_t tx = cell_of(x), ty = cell_of(y);
   const std::uint32_t h = hash2(tx, ty, 31U);
   const float wt = lod(kTile, fp);
-  float g = 0.52F + wt * 0.12F * (2.0F * unit(h) - 1.0F);
+  float g = 0.52F + wt * 0.2F * (2.0F * unit(h) - 1.0F);
   Rgb tint = {1.0F, 0.97F, 0.92F};
   if (unit(hash32(h)) < 0.12F) tint = mix(tint, Rgb{1.15F, 0.78F, 0.68F}, wt);  // reddish pavers
   const double e = std::min({x - tx, tx + 1.0 - x, y - ty, ty + 1.0 - y}) * kTile;
@@ -190,7 +191,8 @@ Rgb facade(const SurfacePoint& s, double fp) {
     const double ey = std::min(v / kBh - row, row + 1.0 - v / kBh) * kBh;
     if (std::min(ex, ey) < 0.008) k += (1.15F - k) * lod(0.02, fp);
   }
-  k *= 1.0F + 0.12F * rects(u, v, 1.6, 0.3F, salt + 2U, fp).value();
+  k *= 1.0F + 0.2F * rects(u, v, 1.6, 0.3F, salt + 2U, fp).value();   // weathering
+  k *= 1.0F + 0.3F * rects(u, v, 0.55, 0.22F, salt + 9U, fp).value();  // plaques, vents, dirt
   Rgb c = base * k;
   if (v >= ground_h && v - ground_h - floor_h * fast_floor((v - ground_h) / floor_h) < 0.18) c = mix(c, base * 1.18F, lod(0.18, fp));
   if (v < 0.3) c = mix(c, base * 0.6F, lod(0.3, fp));  // plinth
@@ -317,6 +319,7 @@ Rgb container(const SurfacePoint& s, double fp) {
     const double rib = s.u / 0.28 - fast_floor(s.u / 0.28);
     if (rib < 0.4) k *= 1.0F + 0.18F * lod(0.1, fp);
   }
+  k *= 1.0F + 0.25F * rects(s.u, s.v, 0.4, 0.3F, h + 3U, fp).value();  // dents and stickers
   Rgb c = paint * k;
   const RectHit rust = rects(s.u, s.v, 0.9, 0.4F, h + 1U, fp);
   if (rust.weight > 0.0F) c = mix(c, Rgb{0.35F, 0.18F, 0.08F}, 0.7F * rust.weight);

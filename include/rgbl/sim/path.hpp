@@ -18,7 +18,7 @@ namespace rgbl {
 enum class PathKind {
   straight,  // one straight street
   curve,     // straights joined by bends, alternately left and right
-  loop,      // a rounded rectangle of left turns that ends exactly where it began
+  loop,      // a rounded square of left turns, from halfway along a side back to exactly the start
 };
 
 std::string_view to_string(PathKind kind);
