@@ -179,7 +179,8 @@ Rgb sky(const Eigen::Vector3d& d) {
 Rgb shade(const StreetScene& scene, const std::optional<RayHit>& hit, const Eigen::Vector3d& origin,
           const Eigen::Vector3d& d, double pixel_angle, bool blank) {
   if (!hit) return sky(d);
-  const SurfacePoint s = scene.surface(*hit, origin, d);
+  SurfacePoint s = scene.surface(*hit, origin, d);
+  if (blank && s.kind == SurfaceKind::marking) s.kind = SurfaceKind::road;  // plain road, no paint
   const double len = d.norm();
   const double cos_incidence = std::max(std::abs(s.normal.dot(d)) / len, 0.05);
   // Four samples per pixel: each stands for half a pixel. A slanted surface stretches the footprint

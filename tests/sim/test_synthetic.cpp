@@ -4,6 +4,7 @@
 
 #include <catch2/catch.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -326,4 +327,71 @@ TEST_CASE("options validate and name the key") {
   bad.speed = 0.0;
   CHECK(key_of(bad) == "speed");
   CHECK_THROWS_AS(rgbl::SyntheticGenerator(bad), rgbl::ConfigError);
+}
+
+TEST_CASE("the grey pair is rectified with the calibrated baseline: SGBM gives the exact depth") {
+  rgbl::SyntheticOptions o;  // default size
+  o.frames = 6;
+  o.depth_camera = 0;
+  const rgbl::SyntheticGenerator g(o);
+  const cv::Mat left = g.render_image(5, 0), right = g.render_image(5, 1);
+  const cv::Mat_<float> depth = g.render_depth(5, 0);
+  const auto sgbm = cv::StereoSGBM::create(0, 64, 5, 8 * 25, 32 * 25, 1, 0, 10, 100, 2);
+  cv::Mat disparity;
+  sgbm->compute(left, right, disparity);
+  const double bf = g.calibration().camera(0).camera.fx * g.calibration().baseline(0, 1);
+  int with_depth = 0, valid = 0, good = 0;
+  std::vector<double> rel;
+  for (int v = 0; v < disparity.rows; ++v) {
+    for (int u = 64; u < disparity.cols; ++u) {
+      const float z = depth(v, u);
+      if (z <= 0.0F || z > 60.0F) continue;
+      ++with_depth;
+      const auto d = disparity.at<std::int16_t>(v, u);
+      if (d <= 0) continue;
+      ++valid;
+      const double e = std::abs(bf / (d / 16.0) - z) / z;
+      rel.push_back(e);
+      good += e < 0.05 ? 1 : 0;
+    }
+  }
+  REQUIRE(valid > 0);
+  std::nth_element(rel.begin(), rel.begin() + static_cast<std::ptrdiff_t>(rel.size() / 2), rel.end());
+  INFO(valid << " of " << with_depth << " pixels matched, " << good << " within 5%");
+  CHECK(static_cast<double>(valid) / with_depth > 0.85);
+  CHECK(static_cast<double>(good) / valid > 0.7);
+  CHECK(rel[rel.size() / 2] < 0.03);
+}
+
+TEST_CASE("a surface point looks the same from the next frame: ORB matches follow depth and poses") {
+  rgbl::SyntheticOptions o;  // default size
+  o.frames = 4;
+  o.path.kind = rgbl::PathKind::curve;
+  const rgbl::SyntheticGenerator g(o);
+  const rgbl::CameraCalibration cal = g.calibration().camera(2);
+  const cv::Mat a = g.render_image(2, 2), b = g.render_image(3, 2);
+  const cv::Mat_<float> depth_a = g.render_depth(2, 2);
+  const auto orb = cv::ORB::create(2000);
+  std::vector<cv::KeyPoint> ka, kb;
+  cv::Mat da, db;
+  orb->detectAndCompute(a, cv::noArray(), ka, da);
+  orb->detectAndCompute(b, cv::noArray(), kb, db);
+  std::vector<cv::DMatch> matches;
+  cv::BFMatcher(cv::NORM_HAMMING, true).match(da, db, matches);
+  // where the exact depth and poses say each keypoint of frame 2 must appear in frame 3
+  const Eigen::Isometry3d T_b_a = (g.pose(3) * cal.T_cam_cam0.inverse()).inverse() * (g.pose(2) * cal.T_cam_cam0.inverse());
+  int checked = 0, consistent = 0;
+  for (const auto& m : matches) {
+    if (m.distance > 40) continue;
+    const cv::Point2f pa = ka[static_cast<std::size_t>(m.queryIdx)].pt, pb = kb[static_cast<std::size_t>(m.trainIdx)].pt;
+    const float z = depth_a(cvRound(pa.y), cvRound(pa.x));
+    if (z <= 0.0F) continue;
+    const Eigen::Vector3d p = T_b_a * cal.camera.unproject(Eigen::Vector2d(pa.x, pa.y), z);
+    const Eigen::Vector2d predicted = cal.camera.project_unchecked(p);
+    ++checked;
+    consistent += (predicted - Eigen::Vector2d(pb.x, pb.y)).norm() < 3.0 ? 1 : 0;
+  }
+  INFO(consistent << " of " << checked << " good matches where depth and poses predict");
+  CHECK(checked > 300);
+  CHECK(static_cast<double>(consistent) / checked > 0.9);
 }
