@@ -71,9 +71,12 @@ struct RectHit {
 
 RectHit rects(double u, double v, double cell, float density, std::uint32_t salt, double footprint) {
   const std::int32_t ix = cell_of(u / cell), iy = cell_of(v / cell);
-  const std::uint32_t h = hash2(ix, iy, salt);
+  const std::uint32_t h = hash32(static_cast<std::uint32_t>(ix) * 0x9E3779B1U ^ static_cast<std::uint32_t>(iy) * 0x85EBCA77U ^
+                                 salt * 0xC2B2AE3DU);
   if (unit(h) >= density) return {};
-  const std::uint32_t h1 = hash32(h ^ 0x68E31DA4U), h2 = hash32(h1), h3 = hash32(h2), h4 = hash32(h3);
+  // Further draws by a multiplicative congruential step: unit() reads the well-mixed high bits.
+  const std::uint32_t h1 = hash32(h ^ 0x68E31DA4U), h2 = h1 * 0x2C1B3C6DU + 0x297A2D39U;
+  const std::uint32_t h3 = h2 * 0x2C1B3C6DU + 0x297A2D39U, h4 = h3 * 0x2C1B3C6DU + 0x297A2D39U;
   const double w = cell * (0.25 + 0.7 * unit(h1)), ht = cell * (0.25 + 0.7 * unit(h2));
   const double x0 = ix * cell + (cell - w) * unit(h3), y0 = iy * cell + (cell - ht) * unit(h4);
   if (u < x0 || u >= x0 + w || v < y0 || v >= y0 + ht) return {};
