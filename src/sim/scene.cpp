@@ -180,6 +180,7 @@ void StreetOptions::validate() const {
   require(container_probability >= 0.0 && container_probability <= 1.0, "scene.container_probability",
           "a probability in [0, 1]");
   require(pole_spacing >= 2.0, "scene.pole_spacing", "at least 2 m");
+  require(tree_spacing >= 2.0, "scene.tree_spacing", "at least 2 m");
 }
 
 bool intersect_object(const SceneObject& ob, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
@@ -210,6 +211,18 @@ bool intersect_object(const SceneObject& ob, const Eigen::Vector3d& origin, cons
     if (t_near > t_far || t_near <= t_min || t_near >= t_best) return false;
     t_best = t_near;
     face = static_cast<std::uint8_t>(entry);
+    return true;
+  }
+  if (ob.shape == SceneObject::Shape::sphere) {
+    const double r = ob.hx;
+    const double a = dx * dx + dy * dy + dz * dz, b = rx * dx + ry * dy + rz * dz;
+    const double c = rx * rx + ry * ry + rz * rz - r * r;
+    const double disc = b * b - a * c;
+    if (disc < 0.0) return false;
+    const double t = (-b - std::sqrt(disc)) / a;
+    if (t <= t_min || t >= t_best) return false;
+    t_best = t;
+    face = 0;
     return true;
   }
   bool hit = false;
@@ -409,6 +422,30 @@ StreetScene::StreetScene(const DrivePath& path, const StreetOptions& options, st
       }
     }
   }
+  // Trees on the sidewalks: a trunk and a round crown that may reach over the parking lane.
+  for (int side = 0; side < 2; ++side) {
+    for (double s = s_begin - 10.0 + rng.uniform(0.0, o.tree_spacing); s < s_end + 10.0;
+         s += o.tree_spacing * rng.uniform(0.6, 1.4)) {
+      const PathPoint p = path.at(s);
+      const double trunk_r = rng.uniform(0.12, 0.22), trunk_h = rng.uniform(2.6, 3.6), crown_r = rng.uniform(1.3, 2.3);
+      const std::uint32_t tseed = rng.next32();
+      const Eigen::Vector2d c = Eigen::Vector2d(p.x, p.z) + (kerb[side] + side_sign[side] * 1.3) * p.right();
+      const SceneObject trunk = cylinder(SurfaceKind::bark, tseed, c, trunk_r, ground_y_, trunk_h + 0.5 * crown_r);
+      if (clearance.distance(footprint(trunk)) < o.road_half_width + 0.5) continue;
+      SceneObject crown;
+      crown.shape = SceneObject::Shape::sphere;
+      crown.kind = SurfaceKind::foliage;
+      crown.seed = tseed;
+      crown.cx = c.x();
+      crown.cz = c.y();
+      crown.cy = ground_y_ - trunk_h - 0.8 * crown_r;
+      crown.hx = crown.hy = crown.hz = crown_r;
+      // keep the crown above the parking lane and out of the driving lanes' space
+      if (clearance.distance(footprint(crown)) < lane_clear) continue;
+      objects_.push_back(trunk);
+      objects_.push_back(crown);
+    }
+  }
   build_grid();
 }
 
@@ -599,6 +636,15 @@ SurfacePoint StreetScene::surface(const RayHit& hit, const Eigen::Vector3d& orig
   const double rx = p.x() - ob.cx, rz = p.z() - ob.cz;
   const double height = ground_y_ - p.y();
   const double top = ground_y_ - (ob.cy - ob.hy);
+  if (ob.shape == SceneObject::Shape::sphere) {
+    const Eigen::Vector3d n = (p - Eigen::Vector3d(ob.cx, ob.cy, ob.cz)) / ob.hx;
+    s.u = (std::atan2(rz, rx) + std::numbers::pi) * ob.hx;
+    s.v = height;
+    s.extent_u = 2.0 * std::numbers::pi * ob.hx;
+    s.extent_v = top;
+    s.normal = n;
+    return s;
+  }
   if (ob.shape == SceneObject::Shape::cylinder) {
     if (hit.face == 0) {
       s.u = (std::atan2(rz, rx) + std::numbers::pi) * ob.hx;
@@ -637,7 +683,11 @@ SurfacePoint StreetScene::surface(const RayHit& hit, const Eigen::Vector3d& orig
 double StreetScene::signed_distance(const Eigen::Vector3d& p) const {
   double d = ground_y_ - p.y();
   for (const auto& ob : objects_) {
-    d = std::min(d, ob.shape == SceneObject::Shape::box ? box_sdf(ob, p) : cylinder_sdf(ob, p));
+    switch (ob.shape) {
+      case SceneObject::Shape::box: d = std::min(d, box_sdf(ob, p)); break;
+      case SceneObject::Shape::cylinder: d = std::min(d, cylinder_sdf(ob, p)); break;
+      case SceneObject::Shape::sphere: d = std::min(d, (p - Eigen::Vector3d(ob.cx, ob.cy, ob.cz)).norm() - ob.hx); break;
+    }
   }
   return d;
 }

@@ -70,7 +70,7 @@ class ViewCaster {
     const auto& objects = scene.objects();
     for (std::size_t i = 0; i < objects.size(); ++i) {
       const SceneObject& o = objects[i];
-      const double ax = o.shape == SceneObject::Shape::box ? o.ax : 1.0;
+      const double ax = o.shape == SceneObject::Shape::box ? o.ax : 1.0;  // round shapes: their bounding box
       const double az = o.shape == SceneObject::Shape::box ? o.az : 0.0;
       std::array<Eigen::Vector3d, 8> c;
       for (int k = 0; k < 8; ++k) {

@@ -363,6 +363,23 @@ Rgb sign(const SurfacePoint& s, double fp) {
   return c;
 }
 
+Rgb bark(const SurfacePoint& s, double fp) {
+  const std::uint32_t h = hash32(s.seed + 505U);
+  float k = 0.9F + 0.15F * fbm(s.u * 3.0, s.v, 0.5, 4, h, fp);
+  k *= 1.0F + 0.35F * rects(s.u, s.v, 0.09, 0.35F, h + 1U, fp).value();
+  return Rgb{0.30F, 0.22F, 0.15F} * k;
+}
+
+// Leaf clusters: dark gaps and lit clumps on two scales, hard-edged (many corners, like real trees).
+Rgb foliage(const SurfacePoint& s, double fp) {
+  const std::uint32_t h = hash32(s.seed + 606U);
+  const Rgb leaf = unit(h) < 0.5F ? Rgb{0.20F, 0.36F, 0.12F} : Rgb{0.26F, 0.38F, 0.10F};
+  float k = 0.85F + 0.25F * fbm(s.u, s.v, 0.8, 4, h, fp);
+  k *= 1.0F + 0.55F * rects(s.u, s.v, 0.3, 0.5F, h + 1U, fp).value();
+  k *= 1.0F + 0.45F * rects(s.u + 0.07, s.v + 0.05, 0.12, 0.45F, h + 2U, fp).value();
+  return leaf * k;
+}
+
 }  // namespace
 
 Rgb albedo(const SurfacePoint& s, double footprint) {
@@ -376,6 +393,8 @@ Rgb albedo(const SurfacePoint& s, double footprint) {
     case SurfaceKind::container: return container(s, footprint);
     case SurfaceKind::pole: return pole(s, footprint);
     case SurfaceKind::sign: return sign(s, footprint);
+    case SurfaceKind::bark: return bark(s, footprint);
+    case SurfaceKind::foliage: return foliage(s, footprint);
   }
   return grey(0.5F);
 }

@@ -1,7 +1,7 @@
 #pragma once
 // The synthetic street: a flat textured road with markings, sidewalks, building blocks along both
-// sides, parked cars and containers, poles with signs. Geometry is analytic (the ground plane,
-// boxes that stand upright with any yaw, vertical cylinders), so rays hit it exactly.
+// sides, parked cars and containers, poles with signs, trees. Geometry is analytic (the ground plane,
+// boxes that stand upright with any yaw, vertical cylinders, spheres), so rays hit it exactly.
 //
 // Texture is a function of the surface point alone (the object's own face coordinates, or world x/z
 // on the ground), so one surface point has the same colour from every view. Detail finer than a
@@ -17,7 +17,7 @@
 
 namespace rgbl {
 
-enum class SurfaceKind : std::uint8_t { road, marking, sidewalk, facade, car, cabin, container, pole, sign };
+enum class SurfaceKind : std::uint8_t { road, marking, sidewalk, facade, car, cabin, container, pole, sign, bark, foliage };
 
 struct StreetOptions {
   double camera_height = 1.65;    // m, cam0 above the road (the road is the plane y = camera_height)
@@ -31,6 +31,7 @@ struct StreetOptions {
   double parked_probability = 0.6;     // share of parking slots taken by a car or container
   double container_probability = 0.12; // share of the taken slots holding a container
   double pole_spacing = 16.0;     // m, mean distance between poles along each kerb
+  double tree_spacing = 14.0;     // m, mean distance between trees along each sidewalk
 
   void validate() const;
 };
@@ -52,15 +53,17 @@ struct SurfacePoint {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  // world, outward
 };
 
-// A shape standing on the road: a box with vertical sides and any yaw, or a vertical cylinder.
+// A shape of the street: a box with vertical sides and any yaw, a vertical cylinder, or a sphere
+// (a tree's crown).
 struct SceneObject {
-  enum class Shape : std::uint8_t { box, cylinder };
+  enum class Shape : std::uint8_t { box, cylinder, sphere };
   Shape shape = Shape::box;
   SurfaceKind kind = SurfaceKind::facade;
   std::uint32_t seed = 0;
   double cx = 0.0, cy = 0.0, cz = 0.0;  // centre, world
   double ax = 1.0, az = 0.0;            // unit local x axis in world (x, z); local z is (-az, ax)
-  double hx = 0.0, hy = 0.0, hz = 0.0;  // half extents along local x, y, z (cylinder: radius, half height, radius)
+  double hx = 0.0, hy = 0.0, hz = 0.0;  // half extents along local x, y, z (cylinder: radius, half height, radius;
+                                        // sphere: the radius thrice)
 };
 
 // A flat mark on the road (asphalt, a painted line): an oriented rectangle in the ground plane.
