@@ -45,8 +45,10 @@ class SequenceWriter {
     write_png(layout_.sequence_dir / "depth" / (name + ".png"), depth16);
     const auto bin = layout_.sequence_dir / "velodyne" / (name + ".bin");
     std::ofstream out(bin, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(f.scan.data()),
-              static_cast<std::streamsize>(f.scan.size() * sizeof(LidarPoint)));
+    if (!f.scan.empty()) {  // a dropped scan is an empty file
+      out.write(reinterpret_cast<const char*>(f.scan.data()),
+                static_cast<std::streamsize>(f.scan.size() * sizeof(LidarPoint)));
+    }
     if (!out) throw Error(fmt::format("cannot write {}", bin.string()));
     times_ << fmt::format("{:.6e}\n", f.timestamp);
     const Matrix34d T = to_3x4(f.T_world_cam0);

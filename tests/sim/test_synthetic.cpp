@@ -32,7 +32,8 @@ bool same_bytes(const cv::Mat& a, const cv::Mat& b) {
 }
 
 bool same_scan(const std::vector<rgbl::LidarPoint>& a, const std::vector<rgbl::LidarPoint>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(rgbl::LidarPoint)) == 0;
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(rgbl::LidarPoint)) == 0);
 }
 
 Eigen::Vector3d world_point(const rgbl::SyntheticGenerator& g, int frame, const rgbl::LidarPoint& p) {
