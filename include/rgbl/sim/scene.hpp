@@ -40,7 +40,7 @@ struct StreetOptions {
 struct RayHit {
   double t = 0.0;               // ray parameter: the hit point is origin + t * direction
   std::uint32_t object = 0;     // index into the scene's objects, or StreetScene::kGround
-  std::uint8_t face = 0;        // box face 0..5 (+x, -x, +y, -y, +z, -z local), cylinder 0 side, 1 top
+  std::uint8_t face = 0;        // box face 0..5 (+x, -x, +y, -y, +z, -z local); cylinder 0 side, 1 top; sphere 0
 };
 
 // What a hit point looks like: where it is on its surface.
