@@ -1,0 +1,132 @@
+// Writing a synthetic sequence in KITTI odometry layout.
+#include "rgbl/core/error.hpp"
+#include "rgbl/sim/synthetic.hpp"
+
+#include <fmt/format.h>
+#include <fmt/os.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <fstream>
+
+namespace rgbl {
+namespace {
+
+class SequenceWriter {
+ public:
+  SequenceWriter(const std::filesystem::path& root, int sequence, const SyntheticOptions& options,
+                 const KittiCalibration& calibration)
+      : layout_(kitti_layout(root, sequence)) {
+    for (const char* dir : {"image_0", "image_1", "image_2", "image_3", "velodyne", "depth"}) {
+      std::filesystem::create_directories(layout_.sequence_dir / dir);
+    }
+    std::filesystem::create_directories(layout_.poses_file.parent_path());
+    write_calibration(calibration);
+    write_options(options);
+    times_.open(layout_.sequence_dir / "times.txt");
+    poses_.open(layout_.poses_file);
+    if (!times_) throw Error(fmt::format("cannot write {}", (layout_.sequence_dir / "times.txt").string()));
+    if (!poses_) throw Error(fmt::format("cannot write {}", layout_.poses_file.string()));
+  }
+
+  void add(const SyntheticFrame& f) {
+    const std::string name = fmt::format("{:06d}", f.index);
+    for (int c = 0; c < 4; ++c) {
+      write_png(layout_.sequence_dir / fmt::format("image_{}", c) / (name + ".png"), f.images[static_cast<std::size_t>(c)]);
+    }
+    // Depth as uint16 = depth * 256 (KITTI depth-completion convention); beyond 255.99 m: 0.
+    cv::Mat depth16(f.depth.rows, f.depth.cols, CV_16UC1);
+    for (int v = 0; v < f.depth.rows; ++v) {
+      for (int u = 0; u < f.depth.cols; ++u) {
+        const double scaled = std::round(static_cast<double>(f.depth(v, u)) * 256.0);
+        depth16.at<std::uint16_t>(v, u) = scaled > 0.0 && scaled <= 65535.0 ? static_cast<std::uint16_t>(scaled) : 0;
+      }
+    }
+    write_png(layout_.sequence_dir / "depth" / (name + ".png"), depth16);
+    const auto bin = layout_.sequence_dir / "velodyne" / (name + ".bin");
+    std::ofstream out(bin, std::ios::binary);
+    if (!f.scan.empty()) {  // a dropped scan is an empty file
+      out.write(reinterpret_cast<const char*>(f.scan.data()),
+                static_cast<std::streamsize>(f.scan.size() * sizeof(LidarPoint)));
+    }
+    if (!out) throw Error(fmt::format("cannot write {}", bin.string()));
+    times_ << fmt::format("{:.6e}\n", f.timestamp);
+    const Matrix34d T = to_3x4(f.T_world_cam0);
+    poses_ << row(T) << '\n';
+  }
+
+  void finish() {
+    times_.close();
+    poses_.close();
+    if (!times_ || !poses_) throw Error(fmt::format("cannot finish writing {}", layout_.root.string()));
+  }
+
+  const KittiLayout& layout() const { return layout_; }
+
+ private:
+  static std::string row(const Matrix34d& M) {
+    std::string s;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) s += fmt::format("{}{:.12e}", s.empty() ? "" : " ", M(r, c) + 0.0);  // no "-0"
+    return s;
+  }
+
+  static void write_png(const std::filesystem::path& file, const cv::Mat& image) {
+    if (!cv::imwrite(file.string(), image)) throw Error(fmt::format("cannot write {}", file.string()));
+  }
+
+  void write_calibration(const KittiCalibration& calibration) const {
+    const auto file = layout_.sequence_dir / "calib.txt";
+    std::ofstream out(file);
+    for (int i = 0; i < 4; ++i) out << fmt::format("P{}: {}\n", i, row(calibration.P[static_cast<std::size_t>(i)]));
+    out << "Tr: " << row(to_3x4(calibration.T_cam0_lidar)) << '\n';
+    if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  }
+
+  void write_options(const SyntheticOptions& o) const {
+    const auto file = layout_.sequence_dir / "sim.txt";
+    std::ofstream out(file);
+    out << "# rgbl synthetic street (rgbl_sim); depth/ holds camera " << o.depth_camera << "'s exact depth\n";
+    out << fmt::format("seed: {}\nframes: {}\npath: {}\nspeed: {}\nframe_period: {}\nwidth: {}\nheight: {}\n", o.seed,
+                       o.frames, to_string(o.path.kind), o.speed, o.frame_period, o.width, o.height);
+    out << fmt::format("image_noise_sigma: {}\ndepth_camera: {}\nlidar_range_noise_sigma: {}\nlidar_dropout: {}\n",
+                       o.image_noise_sigma, o.depth_camera, o.lidar.range_noise_sigma, o.lidar.dropout);
+    if (o.untextured) out << fmt::format("untextured: {} {}\n", o.untextured->first, o.untextured->last);
+    if (!o.dropped_scans.empty()) out << fmt::format("dropped_scans: {}\n", fmt::join(o.dropped_scans, " "));
+    if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  }
+
+  KittiLayout layout_;
+  std::ofstream times_, poses_;
+};
+
+}  // namespace
+
+KittiLayout kitti_layout(const std::filesystem::path& root, int sequence) {
+  require(sequence >= 0 && sequence <= 99, "sequence", "a sequence number 0..99");
+  KittiLayout l;
+  l.root = root;
+  l.sequence_dir = root / "sequences" / fmt::format("{:02d}", sequence);
+  l.poses_file = root / "poses" / fmt::format("{:02d}.txt", sequence);
+  return l;
+}
+
+KittiLayout write_kitti(const SyntheticGenerator& generator, const std::filesystem::path& root, int sequence,
+                        const std::function<void(int)>& on_frame) {
+  SequenceWriter writer(root, sequence, generator.options(), generator.calibration());
+  for (int i = 0; i < generator.frame_count(); ++i) {
+    writer.add(generator.render(i));
+    if (on_frame) on_frame(i);
+  }
+  writer.finish();
+  return writer.layout();
+}
+
+KittiLayout write_kitti(const SyntheticSequence& sequence, const std::filesystem::path& root, int sequence_number) {
+  SequenceWriter writer(root, sequence_number, sequence.options, sequence.calibration);
+  for (const auto& f : sequence.frames) writer.add(f);
+  writer.finish();
+  return writer.layout();
+}
+
+}  // namespace rgbl

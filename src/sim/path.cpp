@@ -1,0 +1,152 @@
+#include "rgbl/sim/path.hpp"
+
+#include "rgbl/core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace rgbl {
+namespace {
+
+// Open paths are laid out this far beyond the requested length, so that the street ahead of the last
+// frame looks like the rest of it.
+constexpr double kOpenMargin = 150.0;
+
+PathPoint advance(const PathPoint& p0, double curvature, double ds) {
+  PathPoint p;
+  if (curvature == 0.0) {
+    p.heading = p0.heading;
+    p.x = p0.x + ds * std::sin(p0.heading);
+    p.z = p0.z + ds * std::cos(p0.heading);
+    return p;
+  }
+  p.heading = p0.heading - curvature * ds;
+  p.x = p0.x + (std::cos(p.heading) - std::cos(p0.heading)) / curvature;
+  p.z = p0.z - (std::sin(p.heading) - std::sin(p0.heading)) / curvature;
+  return p;
+}
+
+}  // namespace
+
+std::string_view to_string(PathKind kind) {
+  switch (kind) {
+    case PathKind::straight: return "straight";
+    case PathKind::curve: return "curve";
+    case PathKind::loop: return "loop";
+  }
+  return "unknown";
+}
+
+std::optional<PathKind> parse_path_kind(std::string_view name) {
+  if (name == "straight") return PathKind::straight;
+  if (name == "curve") return PathKind::curve;
+  if (name == "loop") return PathKind::loop;
+  return std::nullopt;
+}
+
+void PathOptions::validate() const {
+  require(bend_radius >= 15.0, "path.bend_radius", "a radius of at least 15 m");
+  require(bend_angle_deg > 0.0 && bend_angle_deg <= 180.0, "path.bend_angle_deg", "an angle in (0, 180] degrees");
+  require(bend_straight >= 0.0, "path.bend_straight", "a length >= 0 m");
+  require(loop_corner_radius >= 12.0, "path.loop_corner_radius", "a radius of at least 12 m");
+}
+
+Eigen::Vector2d PathPoint::forward() const { return {std::sin(heading), std::cos(heading)}; }
+Eigen::Vector2d PathPoint::right() const { return {std::cos(heading), -std::sin(heading)}; }
+
+DrivePath::DrivePath(const PathOptions& options, double length) {
+  options.validate();
+  require(std::isfinite(length) && length >= 0.0, "path.length", "a finite length >= 0 m");
+  switch (options.kind) {
+    case PathKind::straight:
+      segments_.push_back({length + kOpenMargin, 0.0});
+      break;
+    case PathKind::curve: {
+      const double arc = options.bend_radius * options.bend_angle_deg * std::numbers::pi / 180.0;
+      double covered = 0.0;
+      for (int bend = 0; covered < length + kOpenMargin; ++bend) {
+        if (options.bend_straight > 0.0) segments_.push_back({options.bend_straight, 0.0});
+        const double sign = bend % 2 == 0 ? 1.0 : -1.0;
+        segments_.push_back({arc, sign / options.bend_radius});
+        covered += options.bend_straight + arc;
+      }
+      break;
+    }
+    case PathKind::loop: {
+      const double radius = options.loop_corner_radius;
+      const double corners = 2.0 * std::numbers::pi * radius;
+      require(length >= corners, "path.loop_corner_radius",
+              "a corner radius whose full circle (2 pi r) fits into the loop's length");
+      // Start and end halfway along a side, so that the car comes back to the start on a straight.
+      const double side = (length - corners) / 4.0;
+      if (side > 0.0) segments_.push_back({0.5 * side, 0.0});
+      for (int i = 0; i < 4; ++i) {
+        segments_.push_back({corners / 4.0, 1.0 / radius});
+        if (side > 0.0) segments_.push_back({i < 3 ? side : 0.5 * side, 0.0});
+      }
+      closed_ = true;
+      break;
+    }
+  }
+  build_starts();
+  // The loop's perimeter is the requested length itself (not the sum of its rounded pieces), so that
+  // s = length maps exactly onto s = 0.
+  if (closed_) total_length_ = length;
+}
+
+DrivePath::DrivePath(std::vector<PathSegment> segments, bool closed) : segments_(std::move(segments)), closed_(closed) {
+  for (const auto& seg : segments_) {
+    require(std::isfinite(seg.length) && seg.length > 0.0, "path.segments", "segments of positive finite length");
+    require(std::isfinite(seg.curvature), "path.segments", "finite curvatures");
+  }
+  require(!segments_.empty(), "path.segments", "at least one segment");
+  build_starts();
+}
+
+void DrivePath::build_starts() {
+  starts_.clear();
+  start_s_.clear();
+  PathPoint p;
+  double s = 0.0;
+  for (const auto& seg : segments_) {
+    starts_.push_back(p);
+    start_s_.push_back(s);
+    p = advance(p, seg.curvature, seg.length);
+    s += seg.length;
+  }
+  starts_.push_back(p);  // the end state, used to extrapolate open paths
+  start_s_.push_back(s);
+  total_length_ = s;
+}
+
+PathPoint DrivePath::at(double s) const {
+  if (closed_) {
+    s = std::fmod(s, total_length_);
+    if (s < 0.0) s += total_length_;
+  }
+  if (s < 0.0) return advance(starts_.front(), 0.0, s);
+  if (s >= start_s_.back()) {
+    if (closed_) return starts_.front();  // rounding of the pieces' sum: the loop's end is its start
+    return advance(starts_.back(), 0.0, s - start_s_.back());
+  }
+  const auto it = std::upper_bound(start_s_.begin(), start_s_.end(), s);
+  const auto i = static_cast<std::size_t>(std::distance(start_s_.begin(), it) - 1);
+  return advance(starts_[i], segments_[i].curvature, s - start_s_[i]);
+}
+
+Eigen::Vector2d DrivePath::point(double s, double lateral) const {
+  const PathPoint p = at(s);
+  return Eigen::Vector2d(p.x, p.z) + lateral * p.right();
+}
+
+Eigen::Isometry3d DrivePath::pose(double s) const {
+  const PathPoint p = at(s);
+  const double c = std::cos(p.heading), sn = std::sin(p.heading);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() << c, 0.0, sn, 0.0, 1.0, 0.0, -sn, 0.0, c;
+  T.translation() << p.x, 0.0, p.z;
+  return T;
+}
+
+}  // namespace rgbl

@@ -1,0 +1,420 @@
+#include "rgbl/sim/synthetic.hpp"
+
+#include "hash.hpp"
+#include "rgbl/core/error.hpp"
+#include "texture.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <thread>
+
+namespace rgbl {
+namespace {
+
+using sim_detail::Rgb;
+
+constexpr double kKittiWidth = 1226.0, kKittiHeight = 370.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Runs fn(i) for i in [0, n), items interleaved over `threads` threads (rows of an image differ in
+// cost: sky is cheap, street is not). Results must not depend on which thread ran an item.
+template <typename Fn>
+void parallel_for(int n, int threads, Fn&& fn) {
+  threads = std::clamp(threads, 1, std::max(1, n));
+  if (threads == 1) {
+    for (int i = 0; i < n; ++i) fn(i);
+    return;
+  }
+  std::vector<std::jthread> pool;
+  pool.reserve(static_cast<std::size_t>(threads - 1));
+  for (int t = 1; t < threads; ++t) {
+    pool.emplace_back([&, t] {
+      for (int i = t; i < n; i += threads) fn(i);
+    });
+  }
+  for (int i = 0; i < n; i += threads) fn(i);
+}
+
+// An approximately normal deviate (Irwin-Hall of four uniforms, variance 1) from one hash: cheap
+// enough for per-pixel image noise.
+float pixel_noise(std::uint64_t h) {
+  float sum = 0.0F;
+  for (int i = 0; i < 4; ++i) sum += static_cast<float>((h >> (16 * i)) & 0xFFFFU) * (1.0F / 65536.0F);
+  return (sum - 2.0F) * 1.7320508F;
+}
+
+// Casts the rays of one camera at one pose. Objects are binned into 8x8-pixel tiles by their
+// projected bounds, nearest first; camera rays are (x, y, 1) in the camera frame, so the ray
+// parameter is the depth and a ray can stop at the first object whose nearest corner is farther
+// than its current hit. Much cheaper than the scene's general grid walk for a whole image.
+class ViewCaster {
+ public:
+  static constexpr int kTile = 8;
+
+  ViewCaster(const StreetScene& scene, const Eigen::Isometry3d& T_world_cam, const PinholeCamera& cam)
+      : scene_(scene), cam_(cam), R_(T_world_cam.linear()), origin_(T_world_cam.translation()) {
+    const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
+    tiles_x_ = (cam.width + kTile - 1) / kTile;
+    tiles_y_ = (cam.height + kTile - 1) / kTile;
+    struct Span {
+      std::uint32_t id;
+      double z_min;
+      int tx0, tx1, ty0, ty1;
+    };
+    std::vector<Span> spans;
+    constexpr double kNear = 0.01;
+    const auto& objects = scene.objects();
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      const SceneObject& o = objects[i];
+      const double ax = o.shape == SceneObject::Shape::box ? o.ax : 1.0;  // round shapes: their bounding box
+      const double az = o.shape == SceneObject::Shape::box ? o.az : 0.0;
+      std::array<Eigen::Vector3d, 8> c;
+      for (int k = 0; k < 8; ++k) {
+        const double sx = (k & 1) != 0 ? o.hx : -o.hx, sy = (k & 2) != 0 ? o.hy : -o.hy, sz = (k & 4) != 0 ? o.hz : -o.hz;
+        const Eigen::Vector3d w(o.cx + sx * ax - sz * az, o.cy + sy, o.cz + sx * az + sz * ax);
+        c[static_cast<std::size_t>(k)] = T_cam_world * w;
+      }
+      double z_min = kInf, z_max = -kInf;
+      for (const auto& p : c) {
+        z_min = std::min(z_min, p.z());
+        z_max = std::max(z_max, p.z());
+      }
+      if (z_max <= kNear) continue;  // wholly behind the camera
+      // Bounds of the box's part in front of the near plane: its corners there and where its edges
+      // cross the plane.
+      double u0 = kInf, u1 = -kInf, v0 = kInf, v1 = -kInf;
+      auto add = [&](const Eigen::Vector3d& p) {
+        const double u = cam.fx * p.x() / p.z() + cam.cx, v = cam.fy * p.y() / p.z() + cam.cy;
+        u0 = std::min(u0, u);
+        u1 = std::max(u1, u);
+        v0 = std::min(v0, v);
+        v1 = std::max(v1, v);
+      };
+      for (int a = 0; a < 8; ++a) {
+        const auto& pa = c[static_cast<std::size_t>(a)];
+        if (pa.z() > kNear) add(pa);
+        for (const int bit : {1, 2, 4}) {  // the three edges from corner a to a corner with a higher index
+          if ((a & bit) != 0) continue;
+          const auto& pb = c[static_cast<std::size_t>(a | bit)];
+          if ((pa.z() > kNear) != (pb.z() > kNear)) add(pa + (kNear - pa.z()) / (pb.z() - pa.z()) * (pb - pa));
+        }
+      }
+      // Samples lie within half a pixel of their pixel's centre.
+      const int tx0 = std::max(0, static_cast<int>(std::floor((u0 - 0.6) / kTile)));
+      const int tx1 = std::min(tiles_x_ - 1, static_cast<int>(std::floor(std::min(u1 + 0.6, 1e6) / kTile)));
+      const int ty0 = std::max(0, static_cast<int>(std::floor((v0 - 0.6) / kTile)));
+      const int ty1 = std::min(tiles_y_ - 1, static_cast<int>(std::floor(std::min(v1 + 0.6, 1e6) / kTile)));
+      if (tx0 > tx1 || ty0 > ty1) continue;
+      spans.push_back({static_cast<std::uint32_t>(i), std::max(z_min, 0.0), tx0, tx1, ty0, ty1});
+    }
+    std::stable_sort(spans.begin(), spans.end(), [](const Span& a, const Span& b) { return a.z_min < b.z_min; });
+    const auto n_tiles = static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tiles_y_);
+    start_.assign(n_tiles + 1, 0);
+    for (const auto& sp : spans)
+      for (int ty = sp.ty0; ty <= sp.ty1; ++ty)
+        for (int tx = sp.tx0; tx <= sp.tx1; ++tx) ++start_[static_cast<std::size_t>(ty * tiles_x_ + tx) + 1];
+    for (std::size_t t = 0; t < n_tiles; ++t) start_[t + 1] += start_[t];
+    entries_.resize(start_[n_tiles]);
+    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+    for (const auto& sp : spans)
+      for (int ty = sp.ty0; ty <= sp.ty1; ++ty)
+        for (int tx = sp.tx0; tx <= sp.tx1; ++tx) entries_[fill[static_cast<std::size_t>(ty * tiles_x_ + tx)]++] = {sp.id, sp.z_min};
+  }
+
+  const Eigen::Vector3d& origin() const { return origin_; }
+
+  // World direction of the ray through image point (x, y) (pixel units, integer at pixel centres).
+  Eigen::Vector3d direction(double x, double y) const {
+    return R_ * Eigen::Vector3d((x - cam_.cx) / cam_.fx, (y - cam_.cy) / cam_.fy, 1.0);
+  }
+
+  // First hit of direction d, cast from within pixel (u, v); t is the camera depth.
+  std::optional<RayHit> cast(int u, int v, const Eigen::Vector3d& d) const {
+    double best = kInf;
+    bool ground = false;
+    if (d.y() > 0.0) {
+      best = (scene_.ground_y() - origin_.y()) / d.y();
+      ground = true;
+    }
+    std::uint32_t hit = StreetScene::kGround;
+    std::uint8_t face = 0;
+    const auto tile = static_cast<std::size_t>((v / kTile) * tiles_x_ + u / kTile);
+    const auto& objects = scene_.objects();
+    for (std::uint32_t k = start_[tile]; k < start_[tile + 1]; ++k) {
+      const Entry& e = entries_[k];
+      if (e.z_min >= best) break;
+      if (intersect_object(objects[e.id], origin_, d, 1e-9, best, face)) hit = e.id;
+    }
+    if (hit != StreetScene::kGround) return RayHit{best, hit, face};
+    if (ground) return RayHit{best, StreetScene::kGround, 0};
+    return std::nullopt;
+  }
+
+ private:
+  struct Entry {
+    std::uint32_t id;
+    double z_min;
+  };
+  const StreetScene& scene_;
+  PinholeCamera cam_;
+  Eigen::Matrix3d R_;
+  Eigen::Vector3d origin_;
+  int tiles_x_ = 0, tiles_y_ = 0;
+  std::vector<std::uint32_t> start_;
+  std::vector<Entry> entries_;
+};
+
+Rgb sky(const Eigen::Vector3d& d) {
+  const double up = std::clamp(-d.y() / d.norm() * 2.5, 0.0, 1.0);
+  const auto w = static_cast<float>(up);
+  return {0.86F + (0.45F - 0.86F) * w, 0.89F + (0.60F - 0.89F) * w, 0.93F + (0.86F - 0.93F) * w};
+}
+
+// Radiance of a hit: albedo under a fixed sun plus ambient light (Lambertian; the view does not
+// enter), or the sky when nothing was hit.
+Rgb shade(const StreetScene& scene, const std::optional<RayHit>& hit, const Eigen::Vector3d& origin,
+          const Eigen::Vector3d& d, double pixel_angle, bool blank) {
+  if (!hit) return sky(d);
+  SurfacePoint s = scene.surface(*hit, origin, d);
+  if (blank && s.kind == SurfaceKind::marking) s.kind = SurfaceKind::road;  // plain road, no paint
+  const double len = d.norm();
+  const double cos_incidence = std::max(std::abs(s.normal.dot(d)) / len, 0.05);
+  // Four samples per pixel: each stands for half a pixel. A slanted surface stretches the footprint
+  // along one axis only: take the geometric mean of its two axes.
+  const double footprint = blank ? kInf : 0.5 * hit->t * len * pixel_angle / std::sqrt(cos_incidence);
+  const Rgb a = sim_detail::albedo(s, footprint);
+  static const Eigen::Vector3d kSun = Eigen::Vector3d(0.35, -0.85, 0.40).normalized();
+  const auto light = static_cast<float>(0.7 + 0.4 * std::max(0.0, s.normal.dot(kSun)));
+  return {a.r * light, a.g * light, a.b * light};
+}
+
+std::uint8_t to_byte(float value) {
+  return static_cast<std::uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+}
+
+}  // namespace
+
+KittiCalibration kitti_odometry_04_calibration() {
+  KittiCalibration c;
+  c.P[0] << 7.070912e+02, 0.0, 6.018873e+02, 0.0, 0.0, 7.070912e+02, 1.831104e+02, 0.0, 0.0, 0.0, 1.0, 0.0;
+  c.P[1] << 7.070912e+02, 0.0, 6.018873e+02, -3.798145e+02, 0.0, 7.070912e+02, 1.831104e+02, 0.0, 0.0, 0.0, 1.0, 0.0;
+  c.P[2] << 7.070912e+02, 0.0, 6.018873e+02, 4.688783e+01, 0.0, 7.070912e+02, 1.831104e+02, 1.178601e-01, 0.0, 0.0,
+      1.0, 6.203223e-03;
+  c.P[3] << 7.070912e+02, 0.0, 6.018873e+02, -3.334597e+02, 0.0, 7.070912e+02, 1.831104e+02, 1.930130e+00, 0.0, 0.0,
+      1.0, 3.318498e-03;
+  Matrix34d Tr;
+  Tr << -1.857739385241e-03, -9.999659513510e-01, -8.039975204516e-03, -4.784029760483e-03, -6.481465826011e-03,
+      8.051860151134e-03, -9.999466081774e-01, -7.337429464231e-02, 9.999773098287e-01, -1.805528627661e-03,
+      -6.496203536139e-03, -3.339968064433e-01;
+  // KITTI's rotation is orthonormal to ~1e-7 only; re-orthonormalise so that Tr is an exact rigid motion.
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(Tr.leftCols<3>(), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  c.T_cam0_lidar = make_isometry(svd.matrixU() * svd.matrixV().transpose(), Tr.col(3));
+  c.width.fill(static_cast<int>(kKittiWidth));
+  c.height.fill(static_cast<int>(kKittiHeight));
+  return c;
+}
+
+void SimLidarOptions::validate() const {
+  require(beams >= 2 && beams <= 256, "lidar.beams", "2..256 beams");
+  require(max_elevation_deg < 60.0 && min_elevation_deg > -60.0 && max_elevation_deg > min_elevation_deg,
+          "lidar.max_elevation_deg", "-60 < lidar.min_elevation_deg < lidar.max_elevation_deg < 60");
+  require(azimuth_step_deg >= 0.01 && azimuth_step_deg <= 10.0, "lidar.azimuth_step_deg", "a step in [0.01, 10] degrees");
+  require(min_range >= 0.0 && max_range > min_range, "lidar.max_range", "0 <= lidar.min_range < lidar.max_range");
+  require(range_noise_sigma >= 0.0 && range_noise_sigma < 1.0, "lidar.range_noise_sigma", "a sigma in [0, 1) m");
+  require(dropout >= 0.0 && dropout < 1.0, "lidar.dropout", "a probability in [0, 1)");
+  require(T_cam0_lidar.matrix().allFinite(), "lidar.T_cam0_lidar", "a finite rigid transform");
+}
+
+std::vector<double> SimLidarOptions::elevations_deg() const {
+  // HDL-64E: the upper block's 32 lasers are 1/3 deg apart over the top 10.33 deg of the 26.8 deg
+  // field, the lower block's 32 spread over the rest after a half-degree gap.
+  const int upper = beams / 2, lower = beams - upper;
+  const double span = max_elevation_deg - min_elevation_deg;
+  const double upper_span = span * (31.0 / 3.0) / 26.8;
+  const double upper_step = upper > 1 ? upper_span / (upper - 1) : 0.0;
+  const double lower_top = max_elevation_deg - upper_span - 1.5 * upper_step;
+  std::vector<double> e;
+  for (int i = 0; i < upper; ++i) e.push_back(max_elevation_deg - i * upper_step);
+  for (int i = 0; i < lower; ++i) {
+    e.push_back(lower > 1 ? lower_top - i * (lower_top - min_elevation_deg) / (lower - 1) : min_elevation_deg);
+  }
+  return e;
+}
+
+void SyntheticOptions::validate() const {
+  require(frames >= 1 && frames <= 100000, "frames", "1..100000 frames");
+  require(std::isfinite(speed) && speed > 0.0 && speed <= 60.0, "speed", "a speed in (0, 60] m/s");
+  require(std::isfinite(frame_period) && frame_period > 0.0 && frame_period <= 10.0, "frame_period",
+          "a period in (0, 10] s");
+  require(width >= 32 && width <= 4096, "width", "32..4096 pixels");
+  require(height >= 16 && height <= 4096, "height", "16..4096 pixels");
+  require(image_noise_sigma >= 0.0 && image_noise_sigma <= 50.0, "image_noise_sigma", "a sigma in [0, 50] grey levels");
+  require(depth_camera >= 0 && depth_camera <= 3, "depth_camera", "a camera index 0..3");
+  require(threads >= 1 && threads <= 64, "threads", "1..64 threads");
+  path.validate();
+  scene.validate();
+  lidar.validate();
+  if (path.kind == PathKind::loop) {
+    require((frames - 1) * step() >= 2.0 * std::numbers::pi * path.loop_corner_radius, "frames",
+            "enough frames for the loop: (frames - 1) * speed * frame_period >= 2 pi path.loop_corner_radius");
+  }
+  if (untextured) {
+    require(untextured->first >= 0 && untextured->first <= untextured->last && untextured->last < frames, "untextured",
+            "a frame range first..last inside the sequence");
+  }
+  for (const int f : dropped_scans) require(f >= 0 && f < frames, "dropped_scans", "frame indices inside the sequence");
+}
+
+SyntheticGenerator::SyntheticGenerator(SyntheticOptions options) : options_(std::move(options)) {
+  options_.validate();
+  const double length = (options_.frames - 1) * options_.step();
+  path_ = std::make_unique<DrivePath>(options_.path, length);
+  scene_ = std::make_unique<StreetScene>(*path_, options_.scene, sim_detail::mix64(options_.seed, 0x5CE4EULL), -40.0,
+                                         length + 120.0);
+
+  // KITTI 04's rig scaled to the image size: same offsets between the cameras, scaled intrinsics.
+  const KittiCalibration kitti = kitti_odometry_04_calibration();
+  const double sx = options_.width / kKittiWidth, sy = options_.height / kKittiHeight;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const Eigen::Matrix3d K04 = kitti.P[i].leftCols<3>();
+    const Eigen::Vector3d t = K04.inverse() * kitti.P[i].col(3);
+    Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+    K(0, 0) = K(1, 1) = K04(0, 0) * sx;
+    K(0, 2) = (K04(0, 2) + 0.5) * sx - 0.5;  // pixel centres at integers
+    K(1, 2) = (K04(1, 2) + 0.5) * sy - 0.5;
+    calibration_.P[i].leftCols<3>() = K;
+    calibration_.P[i].col(3) = K * t;
+  }
+  calibration_.T_cam0_lidar = options_.lidar.T_cam0_lidar;
+  calibration_.width.fill(options_.width);
+  calibration_.height.fill(options_.height);
+}
+
+Eigen::Isometry3d SyntheticGenerator::pose(int frame) const { return path_->pose(frame * options_.step()); }
+
+double SyntheticGenerator::timestamp(int frame) const { return frame * options_.frame_period; }
+
+Eigen::Isometry3d SyntheticGenerator::T_world_camera(int frame, int camera) const {
+  return pose(frame) * calibration_.camera(camera).T_cam_cam0.inverse();
+}
+
+cv::Mat SyntheticGenerator::render_image(int frame, int camera) const {
+  require(frame >= 0 && frame < options_.frames, "frame", "a frame index inside the sequence");
+  const CameraCalibration cal = calibration_.camera(camera);
+  const PinholeCamera& cam = cal.camera;
+  const ViewCaster caster(*scene_, T_world_camera(frame, camera), cam);
+  const bool colour = camera >= 2;
+  const bool blank = options_.untextured && options_.untextured->contains(frame);
+  const auto sigma = static_cast<float>(options_.image_noise_sigma);
+  const std::uint64_t noise_key = sim_detail::mix64(options_.seed, static_cast<std::uint64_t>(frame),
+                                                    0x1A6E0000ULL + static_cast<std::uint64_t>(camera));
+  const double pixel_angle = 1.0 / cam.fx;
+  cv::Mat image(cam.height, cam.width, colour ? CV_8UC3 : CV_8UC1);
+  constexpr double kOffsets[4][2] = {{-0.25, -0.25}, {0.25, -0.25}, {-0.25, 0.25}, {0.25, 0.25}};
+  parallel_for(cam.height, options_.threads, [&](int v) {
+    auto* row = image.ptr<std::uint8_t>(v);
+    for (int u = 0; u < cam.width; ++u) {
+      Rgb sum;
+      for (const auto& o : kOffsets) {
+        const Eigen::Vector3d d = caster.direction(u + o[0], v + o[1]);
+        const Rgb c = shade(*scene_, caster.cast(u, v, d), caster.origin(), d, pixel_angle, blank);
+        sum = {sum.r + c.r, sum.g + c.g, sum.b + c.b};
+      }
+      const std::uint64_t h = sim_detail::mix64(noise_key, static_cast<std::uint64_t>(v) * 65536U + static_cast<std::uint64_t>(u));
+      if (colour) {
+        // OpenCV's channel order: B, G, R.
+        row[3 * u + 0] = to_byte(sum.b * 63.75F + sigma * pixel_noise(sim_detail::mix64(h, 0)));
+        row[3 * u + 1] = to_byte(sum.g * 63.75F + sigma * pixel_noise(sim_detail::mix64(h, 1)));
+        row[3 * u + 2] = to_byte(sum.r * 63.75F + sigma * pixel_noise(sim_detail::mix64(h, 2)));
+      } else {
+        const float grey = (0.299F * sum.r + 0.587F * sum.g + 0.114F * sum.b) * 63.75F;
+        row[u] = to_byte(grey + sigma * pixel_noise(h));
+      }
+    }
+  });
+  return image;
+}
+
+cv::Mat_<float> SyntheticGenerator::render_depth(int frame, int camera) const {
+  require(frame >= 0 && frame < options_.frames, "frame", "a frame index inside the sequence");
+  const PinholeCamera cam = calibration_.camera(camera).camera;
+  const ViewCaster caster(*scene_, T_world_camera(frame, camera), cam);
+  cv::Mat_<float> depth(cam.height, cam.width, 0.0F);
+  parallel_for(cam.height, options_.threads, [&](int v) {
+    float* row = depth[v];
+    for (int u = 0; u < cam.width; ++u) {
+      // With the ray's camera-frame z component 1, the ray parameter is the depth itself.
+      const auto hit = caster.cast(u, v, caster.direction(u, v));
+      row[u] = hit ? static_cast<float>(hit->t) : 0.0F;
+    }
+  });
+  return depth;
+}
+
+std::vector<LidarPoint> SyntheticGenerator::render_scan(int frame) const {
+  require(frame >= 0 && frame < options_.frames, "frame", "a frame index inside the sequence");
+  if (std::find(options_.dropped_scans.begin(), options_.dropped_scans.end(), frame) != options_.dropped_scans.end()) {
+    return {};
+  }
+  const SimLidarOptions& lo = options_.lidar;
+  const Eigen::Isometry3d T_world_lidar = pose(frame) * lo.T_cam0_lidar;
+  const Eigen::Matrix3d R = T_world_lidar.linear();
+  const Eigen::Vector3d origin = T_world_lidar.translation();
+  const std::vector<double> elevations = lo.elevations_deg();
+  const int columns = static_cast<int>(std::lround(360.0 / lo.azimuth_step_deg));
+  const std::uint64_t key = sim_detail::mix64(options_.seed, static_cast<std::uint64_t>(frame), 0x11DA5ULL);
+  std::vector<std::vector<LidarPoint>> rings(elevations.size());
+  parallel_for(static_cast<int>(elevations.size()), options_.threads, [&](int b) {
+    const double e = elevations[static_cast<std::size_t>(b)] * kDeg;
+    auto& ring = rings[static_cast<std::size_t>(b)];
+    ring.reserve(static_cast<std::size_t>(columns));
+    for (int k = 0; k < columns; ++k) {
+      // Rings sweep from straight behind, counter-clockwise seen from above (as KITTI's scans).
+      const double azimuth = -std::numbers::pi + (k + 0.5) * 2.0 * std::numbers::pi / columns;
+      const Eigen::Vector3d dir(std::cos(e) * std::cos(azimuth), std::cos(e) * std::sin(azimuth), std::sin(e));
+      const Eigen::Vector3d d = R * dir;
+      const auto hit = scene_->intersect(origin, d, lo.max_range);
+      if (!hit || hit->t < lo.min_range) continue;
+      const std::uint64_t h = sim_detail::mix64(key, static_cast<std::uint64_t>(b) * 100000U + static_cast<std::uint64_t>(k));
+      if (lo.dropout > 0.0 && sim_detail::unit64(sim_detail::mix64(h, 7)) < lo.dropout) continue;
+      const double range = hit->t + (lo.range_noise_sigma > 0.0 ? lo.range_noise_sigma * sim_detail::gaussian(h) : 0.0);
+      const Rgb a = sim_detail::albedo(scene_->surface(*hit, origin, d), 0.003 * hit->t);
+      const Eigen::Vector3d p = range * dir;
+      ring.push_back({static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()),
+                      std::clamp(0.299F * a.r + 0.587F * a.g + 0.114F * a.b, 0.0F, 1.0F)});
+    }
+  });
+  std::vector<LidarPoint> scan;
+  std::size_t total = 0;
+  for (const auto& r : rings) total += r.size();
+  scan.reserve(total);
+  for (const auto& r : rings) scan.insert(scan.end(), r.begin(), r.end());
+  return scan;
+}
+
+SyntheticFrame SyntheticGenerator::render(int frame) const {
+  SyntheticFrame f;
+  f.index = frame;
+  f.timestamp = timestamp(frame);
+  f.T_world_cam0 = pose(frame);
+  for (int c = 0; c < 4; ++c) f.images[static_cast<std::size_t>(c)] = render_image(frame, c);
+  f.depth = render_depth(frame, options_.depth_camera);
+  f.scan = render_scan(frame);
+  return f;
+}
+
+SyntheticSequence generate_sequence(const SyntheticOptions& options) {
+  const SyntheticGenerator generator(options);
+  SyntheticSequence seq;
+  seq.options = generator.options();
+  seq.calibration = generator.calibration();
+  seq.frames.reserve(static_cast<std::size_t>(generator.frame_count()));
+  for (int i = 0; i < generator.frame_count(); ++i) seq.frames.push_back(generator.render(i));
+  return seq;
+}
+
+}  // namespace rgbl
