@@ -1,0 +1,58 @@
+#pragma once
+// Every threshold of tracking and local mapping, with ORB-SLAM3's RGB-D values as defaults where the
+// SPEC gives them.
+
+#include "rgbl/backend/bundle_adjustment.hpp"
+#include "rgbl/backend/depth_noise.hpp"
+#include "rgbl/backend/pose_optimizer.hpp"
+#include "rgbl/map/map.hpp"
+
+namespace rgbl {
+
+struct TrackerOptions {
+  int min_initial_depth_points = 300;   // keypoints with usable depth to initialise
+  double motion_radius = 15.0;          // px at level 0, guided matching with the motion model
+  int motion_min_matches = 20;          // retry with 2x radius below this
+  double local_map_radius = 3.0;        // px at level 0, local-map search
+  int max_hamming = 100;
+  int max_hamming_strict = 50;
+  double local_map_ratio = 0.8;
+  double reference_ratio = 0.7;         // brute-force fallback against the reference keyframe
+  double min_view_cos = 0.5;            // viewing-angle test
+  int max_local_keyframes = 80;
+  int min_pose_inliers = 10;            // pose optimisation success
+  int min_local_map_inliers = 30;       // local-map tracking success
+  int relocalisation_min_inliers = 50;
+  bool check_orientation = true;        // rotation histogram consistency in guided matching
+  // Keyframe decision (SPEC section 5)
+  int max_frames_between_keyframes = 10;
+  double reference_ratio_threshold = 0.75;
+  int close_tracked_threshold = 100, close_untracked_threshold = 70;
+  int min_keyframe_inliers = 15;
+  double close_depth = 97.0;            // m; "close" points (RGB-L: bf/fx * ThDepth = 100/707 * 700)
+
+  PoseOptimizerOptions pose;
+
+  void validate() const;
+};
+
+struct LocalMappingOptions {
+  int min_new_depth_points = 100;       // at least this many new landmarks from depth per keyframe
+  int max_new_depth_points = 1000;
+  int covisible_for_fusion = 10;
+  double fusion_radius = 3.0;           // px at level 0
+  int max_local_ba_keyframes = 10;      // optimised keyframes (the current one and its best covisible)
+  int max_fixed_keyframes = 20;
+  double min_found_ratio = 0.25;        // landmark culling
+  int min_observations = 3;             // landmark culling after 2 keyframes
+  double redundant_ratio = 0.9;         // keyframe culling
+  int redundant_observers = 3;
+  bool local_ba = true;
+  bool keyframe_culling = true;
+  bool fusion = true;
+  BundleAdjustmentOptions ba;
+
+  void validate() const;
+};
+
+}  // namespace rgbl

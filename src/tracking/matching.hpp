@@ -1,0 +1,33 @@
+#pragma once
+// Private matching helpers of the tracker (guided search by projection, brute force).
+
+#include "rgbl/features/types.hpp"
+#include "rgbl/map/map.hpp"
+#include "rgbl/tracking/frame.hpp"
+
+#include <span>
+#include <utility>
+#include <vector>
+
+namespace rgbl::detail {
+
+struct ProjectedLandmark {
+  LandmarkId id;
+  const Descriptor* descriptor = nullptr;
+  float x = 0.0F, y = 0.0F;
+  float radius = 0.0F;
+  int min_level = 0, max_level = -1;
+  float angle = -1.0F;  // angle of the keypoint it was last seen as; < 0 = unknown
+};
+
+// Assigns frame.landmarks for the best keypoint of each candidate (only keypoints without a landmark).
+// ratio < 1 applies the best/second-best test when both come from the same level.
+int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates, int max_hamming, double ratio,
+                    bool check_orientation);
+
+// query index -> train index, best match with a ratio test.
+std::vector<std::pair<int, int>> match_brute_force(std::span<const Descriptor> query,
+                                                   std::span<const Descriptor> train, int max_hamming,
+                                                   double ratio);
+
+}  // namespace rgbl::detail
