@@ -5,6 +5,10 @@
 #include "rgbl/geometry/calibration.hpp"
 #include "rgbl/geometry/point_cloud.hpp"
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -60,6 +64,32 @@ inline std::vector<LidarPoint> scan(int frame = 0) {
     }
   }
   return points;
+}
+
+// A real grey frame (image_0, 1226x370), or a synthetic textured image of the same size: smooth
+// blobs plus random rectangles, so that FAST finds corners everywhere.
+inline cv::Mat gray_image(int frame = 0) {
+  if (const auto seq = seq04()) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.png", frame);
+    cv::Mat img = cv::imread((*seq / "image_0" / name).string(), cv::IMREAD_GRAYSCALE);
+    if (!img.empty()) return img;
+  }
+  std::fprintf(stderr, "rgbl_bench: no KITTI image found, using a synthetic textured 1226x370 image\n");
+  std::mt19937 rng(7U + static_cast<unsigned>(frame));
+  cv::Mat img(370, 1226, CV_8UC1);
+  for (int y = 0; y < img.rows; ++y) {
+    for (int x = 0; x < img.cols; ++x) {
+      img.at<std::uint8_t>(y, x) =
+          static_cast<std::uint8_t>(128.0 + 60.0 * std::sin(x * 0.05) * std::cos(y * 0.07));
+    }
+  }
+  std::uniform_int_distribution<int> px(0, img.cols - 1), py(0, img.rows - 1), side(3, 30), value(0, 255);
+  for (int i = 0; i < 3000; ++i) {
+    const cv::Rect r(px(rng), py(rng), side(rng), side(rng));
+    img(r & cv::Rect(0, 0, img.cols, img.rows)).setTo(value(rng));
+  }
+  return img;
 }
 
 }  // namespace rgbl::bench

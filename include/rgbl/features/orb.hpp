@@ -1,0 +1,103 @@
+#pragma once
+// ORB extraction (ORB-SLAM semantics): image pyramid with a geometric per-level budget, FAST with a
+// per-cell threshold fallback, quadtree distribution keeping the strongest corner per node,
+// intensity-centroid orientation and 256-bit rotated BRIEF on a Gaussian-smoothed level.
+
+#include "rgbl/features/types.hpp"
+
+#include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
+
+#include <cstdint>
+
+#include <span>
+#include <vector>
+
+namespace rgbl {
+
+namespace detail {
+// A FAST corner in level pixels; score = largest threshold at which it is a corner.
+struct FastCorner {
+  int x, y;
+  int score;
+};
+}  // namespace detail
+
+struct OrbOptions {
+  int num_features = 2000;      // total over all levels
+  int num_levels = 8;
+  float scale_factor = 1.2F;    // between consecutive levels
+  int fast_threshold = 12;      // per-cell threshold...
+  int fast_min_threshold = 7;   // ...and the fallback for cells with no corner at fast_threshold
+  int cell_size = 35;           // px at each level, for the threshold fallback
+  int edge_threshold = 19;      // keypoints keep this many px from every level border
+  int patch_size = 31;          // BRIEF patch diameter; sampling points lie within patch_size / 2
+  int orientation_radius = 15;  // intensity-centroid disc radius
+  int blur_size = 7;            // Gaussian kernel (odd) and sigma of the level smoothed for BRIEF
+  double blur_sigma = 2.0;
+  void validate() const;
+};
+
+// One pair of BRIEF sampling points, offsets from the keypoint in level pixels.
+struct BriefPair {
+  float x1, y1, x2, y2;
+};
+
+// The 256 sampling pairs: drawn from a fixed-seed generator (SplitMix64 + Box-Muller), isotropic
+// Gaussian with sigma = patch_size / 5, clipped to the disc of radius patch_size / 2. The same
+// patch_size always gives the same pattern on every platform.
+std::vector<BriefPair> make_brief_pattern(int patch_size);
+
+// Owns the pyramid and scratch buffers, so reusing one extractor across frames allocates nothing in
+// steady state. Not thread-safe: one extractor per thread.
+class OrbExtractor {
+ public:
+  explicit OrbExtractor(const OrbOptions& options = {});
+
+  // `gray`: CV_8UC1. Clears and fills `keypoints` (level-0 pixel coordinates) and `descriptors` (same
+  // length and order). Ordered by level, then by position within the level's quadtree. Deterministic.
+  void extract(const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors);
+
+  const OrbOptions& options() const noexcept { return options_; }
+  // scale_factor^level for every level: multiply a level's pixel coordinates by it to get level 0.
+  std::span<const float> level_scales() const noexcept { return scales_; }
+  // Features each level aims for (the geometric series; a level's shortfall moves to the next).
+  std::span<const int> level_budgets() const noexcept { return budgets_; }
+  // The pyramid of the last extract() call (level 0 shares the input's data).
+  std::span<const cv::Mat> pyramid() const noexcept { return pyramid_; }
+
+ private:
+  struct Candidate {
+    float x, y;  // level pixels
+    float response;
+  };
+  struct Node {
+    float x0, y0, x1, y1;
+    int begin, end;  // range in candidates_
+  };
+  void build_pyramid(const cv::Mat& gray);
+  void detect_level(int level);
+  void distribute(int target, std::vector<Candidate>& selected);
+  void describe_level(int level, std::span<const Candidate> selected, std::vector<Keypoint>& keypoints,
+                      std::vector<Descriptor>& descriptors);
+
+  OrbOptions options_;
+  std::vector<float> scales_;
+  std::vector<int> budgets_;
+  std::vector<BriefPair> pattern_;
+  std::vector<int> disc_half_width_;  // per row offset 0..radius: half width of the orientation disc
+  // Scratch reused across calls.
+  std::vector<cv::Mat> pyramid_;
+  cv::Mat blurred_;
+  std::vector<detail::FastCorner> fast_;
+  std::vector<std::uint8_t> fast_scores_;
+  std::vector<int> root_counts_;
+  std::vector<Candidate> bucketed_;
+  std::vector<Candidate> candidates_;
+  std::vector<Candidate> selected_;
+  std::vector<Node> nodes_, next_nodes_;
+  std::vector<unsigned char> cell_strong_;
+  std::vector<int> pattern_offsets_;
+};
+
+}  // namespace rgbl

@@ -1,0 +1,174 @@
+#include "fast.hpp"
+
+#include <algorithm>
+#include <array>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace rgbl::detail {
+
+namespace {
+
+// The Bresenham circle of radius 3, clockwise from the top.
+constexpr std::array<std::array<int, 2>, 16> kCircle = {{{0, -3}, {1, -3}, {2, -2}, {3, -1}, {3, 0}, {3, 1},
+                                                         {2, 2}, {1, 3}, {0, 3}, {-1, 3}, {-2, 2}, {-3, 1},
+                                                         {-3, 0}, {-3, -1}, {-2, -2}, {-1, -3}}};
+
+// Score of one pixel: with b[k] = max(p_k - c, 0) and d[k] = max(c - p_k, 0), the best arc of 9 has
+// min over the arc of b (or d) = m; the pixel is a corner at every t < m, so its score is m - 1.
+inline int pixel_score(const std::uint8_t* centre, const std::array<int, 16>& offsets) {
+  const int c = centre[0];
+  std::array<int, 25> b{}, d{};
+  for (std::size_t k = 0; k < 16; ++k) {
+    const int p = centre[offsets[k]];
+    b[k] = std::max(p - c, 0);
+    d[k] = std::max(c - p, 0);
+  }
+  for (std::size_t k = 16; k < 25; ++k) {
+    b[k] = b[k - 16];
+    d[k] = d[k - 16];
+  }
+  int best = 0;
+  for (std::size_t k = 0; k < 16; ++k) {
+    int mb = b[k], md = d[k];
+    for (std::size_t j = 1; j < 9; ++j) {
+      mb = std::min(mb, b[k + j]);
+      md = std::min(md, d[k + j]);
+    }
+    best = std::max(best, std::max(mb, md));
+  }
+  return best - 1;
+}
+
+#if defined(__SSE2__)
+inline __m128i load(const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
+
+// Scores of 16 consecutive pixels (0 where not a corner at `threshold`), written to `out`.
+inline void block_scores(const std::uint8_t* centre, const std::array<int, 16>& offsets, int threshold,
+                         std::uint8_t* out) {
+  const __m128i c = load(centre);
+  const __m128i t1 = _mm_set1_epi8(static_cast<char>(threshold + 1));
+  const __m128i zero = _mm_setzero_si128();
+  // Quick rejection: a 9-arc covers two consecutive compass points (0, 4, 8, 12) of the circle.
+  __m128i b[16], d[16];
+  for (int k = 0; k < 16; k += 4) {
+    const __m128i p = load(centre + offsets[static_cast<std::size_t>(k)]);
+    b[k] = _mm_subs_epu8(p, c);
+    d[k] = _mm_subs_epu8(c, p);
+  }
+  auto ge = [&](__m128i v) { return _mm_cmpeq_epi8(_mm_max_epu8(v, t1), v); };  // v >= threshold + 1
+  const __m128i b0 = ge(b[0]), b4 = ge(b[4]), b8 = ge(b[8]), b12 = ge(b[12]);
+  const __m128i d0 = ge(d[0]), d4 = ge(d[4]), d8 = ge(d[8]), d12 = ge(d[12]);
+  const __m128i possible = _mm_or_si128(
+      _mm_or_si128(_mm_or_si128(_mm_and_si128(b0, b4), _mm_and_si128(b4, b8)),
+                   _mm_or_si128(_mm_and_si128(b8, b12), _mm_and_si128(b12, b0))),
+      _mm_or_si128(_mm_or_si128(_mm_and_si128(d0, d4), _mm_and_si128(d4, d8)),
+                   _mm_or_si128(_mm_and_si128(d8, d12), _mm_and_si128(d12, d0))));
+  if (_mm_movemask_epi8(possible) == 0) {
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out), zero);
+    return;
+  }
+  for (int k = 0; k < 16; ++k) {
+    if (k % 4 == 0) continue;
+    const __m128i p = load(centre + offsets[static_cast<std::size_t>(k)]);
+    b[k] = _mm_subs_epu8(p, c);
+    d[k] = _mm_subs_epu8(c, p);
+  }
+  // Minimum over every cyclic window of 9 by doubling: 2, 4, 8, then one more.
+  auto best_arc = [](const __m128i* v) {
+    __m128i m2[16], m4[16];
+    for (int k = 0; k < 16; ++k) m2[k] = _mm_min_epu8(v[k], v[(k + 1) & 15]);
+    for (int k = 0; k < 16; ++k) m4[k] = _mm_min_epu8(m2[k], m2[(k + 2) & 15]);
+    __m128i best = _mm_setzero_si128();
+    for (int k = 0; k < 16; ++k) {
+      const __m128i m9 = _mm_min_epu8(_mm_min_epu8(m4[k], m4[(k + 4) & 15]), v[(k + 8) & 15]);
+      best = _mm_max_epu8(best, m9);
+    }
+    return best;
+  };
+  const __m128i s = _mm_max_epu8(best_arc(b), best_arc(d));
+  // Corner where s >= threshold + 1; its score is s - 1 (>= threshold >= 1, so never 0).
+  const __m128i corner = ge(s);
+  const __m128i score = _mm_and_si128(corner, _mm_subs_epu8(s, _mm_set1_epi8(1)));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out), score);
+}
+#endif
+
+}  // namespace
+
+void fast_score_map(const cv::Mat& img, cv::Rect region, int threshold, std::vector<std::uint8_t>& scores) {
+  const int map_w = region.width + 2;
+  // 16 bytes of padding let the non-maximum pass read whole 16-byte blocks at the end of the map.
+  scores.assign(static_cast<std::size_t>(map_w) * static_cast<std::size_t>(region.height + 2) + 16, 0);
+  const auto step = static_cast<int>(img.step1());
+  std::array<int, 16> offsets{};
+  for (std::size_t k = 0; k < 16; ++k) offsets[k] = kCircle[k][1] * step + kCircle[k][0];
+  for (int y = region.y; y < region.y + region.height; ++y) {
+    const std::uint8_t* row = img.ptr<std::uint8_t>(y);
+    std::uint8_t* out = scores.data() + static_cast<std::size_t>(y - region.y + 1) * static_cast<std::size_t>(map_w) + 1;
+    int x = region.x;
+    const int end = region.x + region.width;
+#if defined(__SSE2__)
+    if (region.width >= 16) {
+      for (; x + 16 <= end; x += 16) block_scores(row + x, offsets, threshold, out + (x - region.x));
+      // The tail as one more (overlapping) block: it rewrites the same values.
+      if (x < end) block_scores(row + end - 16, offsets, threshold, out + (end - 16 - region.x));
+      x = end;
+    }
+#endif
+    for (; x < end; ++x) {
+      const int s = pixel_score(row + x, offsets);
+      out[x - region.x] = static_cast<std::uint8_t>(s >= threshold ? s : 0);
+    }
+  }
+}
+
+void detect_fast(const cv::Mat& img, cv::Rect region, int threshold, std::vector<std::uint8_t>& scores,
+                 std::vector<FastCorner>& corners) {
+  corners.clear();
+  if (region.width <= 0 || region.height <= 0) return;
+  fast_score_map(img, region, threshold, scores);
+  const int map_w = region.width + 2;
+  for (int y = 1; y <= region.height; ++y) {
+    const std::uint8_t* up = scores.data() + static_cast<std::size_t>(y - 1) * static_cast<std::size_t>(map_w);
+    const std::uint8_t* mid = up + map_w;
+    const std::uint8_t* down = mid + map_w;
+#if defined(__SSE2__)
+    // 16 map entries at a time, the local-maximum test done on all of them with unsigned byte
+    // compares (a > b as max(a, b) == a and a != b); the map is padded so whole blocks can be read.
+    for (int x = 1; x <= region.width; x += 16) {
+      const __m128i s = load(mid + x);
+      const __m128i zero = _mm_setzero_si128();
+      auto mask = static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(s, zero))) ^ 0xFFFFU;
+      if (mask == 0) continue;
+      auto ge = [&](const std::uint8_t* p) { return _mm_cmpeq_epi8(_mm_max_epu8(s, load(p)), s); };
+      auto gt = [&](const std::uint8_t* p) {
+        const __m128i n = load(p);
+        return _mm_andnot_si128(_mm_cmpeq_epi8(s, n), _mm_cmpeq_epi8(_mm_max_epu8(s, n), s));
+      };
+      const __m128i keep = _mm_and_si128(
+          _mm_and_si128(_mm_and_si128(gt(up + x - 1), gt(up + x)), _mm_and_si128(gt(up + x + 1), gt(mid + x - 1))),
+          _mm_and_si128(_mm_and_si128(ge(mid + x + 1), ge(down + x - 1)), _mm_and_si128(ge(down + x), ge(down + x + 1))));
+      mask &= static_cast<unsigned>(_mm_movemask_epi8(keep));
+      if (region.width - x + 1 < 16) mask &= (1U << static_cast<unsigned>(region.width - x + 1)) - 1U;
+      while (mask != 0) {
+        const int bit = __builtin_ctz(mask);
+        mask &= mask - 1U;
+        corners.push_back({region.x + x + bit - 1, region.y + y - 1, mid[x + bit]});
+      }
+    }
+#else
+    for (int x = 1; x <= region.width; ++x) {
+      const int s = mid[x];
+      if (s != 0 && s > up[x - 1] && s > up[x] && s > up[x + 1] && s > mid[x - 1] && s >= mid[x + 1] &&
+          s >= down[x - 1] && s >= down[x] && s >= down[x + 1]) {
+        corners.push_back({region.x + x - 1, region.y + y - 1, s});
+      }
+    }
+#endif
+  }
+}
+
+}  // namespace rgbl::detail

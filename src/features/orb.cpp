@@ -1,0 +1,361 @@
+#include "rgbl/features/orb.hpp"
+
+#include "rgbl/core/error.hpp"
+
+#include "fast.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+namespace rgbl {
+
+void OrbOptions::validate() const {
+  require(num_features > 0, "orb.num_features", "> 0");
+  require(num_levels >= 1 && num_levels <= 32, "orb.num_levels", "in [1, 32]");
+  require(scale_factor > 1.0F && scale_factor <= 4.0F, "orb.scale_factor", "in (1, 4]");
+  require(fast_threshold >= 1 && fast_threshold <= 254, "orb.fast_threshold", "in [1, 254]");
+  require(fast_min_threshold >= 1 && fast_min_threshold <= fast_threshold, "orb.fast_min_threshold",
+          "in [1, fast_threshold]");
+  require(cell_size >= 8, "orb.cell_size", ">= 8");
+  require(patch_size >= 5 && patch_size % 2 == 1, "orb.patch_size", "odd and >= 5");
+  require(orientation_radius >= 1, "orb.orientation_radius", ">= 1");
+  require(edge_threshold >= std::max(patch_size / 2, orientation_radius) + 1 && edge_threshold >= 4,
+          "orb.edge_threshold", "> max(patch_size / 2, orientation_radius) and >= 4");
+  require(blur_size >= 1 && blur_size % 2 == 1, "orb.blur_size", "odd and >= 1");
+  require(blur_sigma > 0.0, "orb.blur_sigma", "> 0");
+}
+
+namespace {
+
+// SplitMix64: a tiny, fully specified generator, so the pattern does not depend on the standard
+// library's distributions (which differ between implementations).
+class SplitMix64 {
+ public:
+  explicit SplitMix64(std::uint64_t seed) : state_(seed) {}
+  std::uint64_t next() {
+    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30U)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27U)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31U);
+  }
+  // Uniform in (0, 1).
+  double uniform() { return (static_cast<double>(next() >> 11U) + 0.5) * (1.0 / 9007199254740992.0); }
+
+ private:
+  std::uint64_t state_;
+};
+
+inline int round_to_int(float v) { return static_cast<int>(v + (v >= 0.0F ? 0.5F : -0.5F)); }
+
+}  // namespace
+
+std::vector<BriefPair> make_brief_pattern(int patch_size) {
+  const double radius = patch_size / 2;  // integer half size: rotated, rounded points stay inside
+  const double sigma = patch_size / 5.0;
+  SplitMix64 rng(0x5247424C4F524231ULL);  // "RGBLORB1"
+  auto gaussian_point = [&]() {
+    for (;;) {
+      // Box-Muller: two independent N(0, sigma) coordinates, redrawn until inside the disc.
+      const double r = std::sqrt(-2.0 * std::log(rng.uniform())) * sigma;
+      const double t = 2.0 * 3.14159265358979323846 * rng.uniform();
+      const double x = r * std::cos(t), y = r * std::sin(t);
+      if (x * x + y * y <= radius * radius) return std::pair{static_cast<float>(x), static_cast<float>(y)};
+    }
+  };
+  std::vector<BriefPair> pattern;
+  pattern.reserve(256);
+  while (pattern.size() < 256) {
+    const auto [x1, y1] = gaussian_point();
+    const auto [x2, y2] = gaussian_point();
+    // A test between (nearly) the same pixel carries no information.
+    if ((x1 - x2) * (x1 - x2) + (y1 - y2) * (y1 - y2) < 4.0F) continue;
+    pattern.push_back({x1, y1, x2, y2});
+  }
+  return pattern;
+}
+
+OrbExtractor::OrbExtractor(const OrbOptions& options) : options_(options) {
+  options_.validate();
+  const int levels = options_.num_levels;
+  scales_.resize(static_cast<std::size_t>(levels));
+  budgets_.resize(static_cast<std::size_t>(levels));
+  scales_[0] = 1.0F;
+  for (int l = 1; l < levels; ++l) {
+    scales_[static_cast<std::size_t>(l)] = scales_[static_cast<std::size_t>(l) - 1] * options_.scale_factor;
+  }
+  // Geometric series in 1/scale: level l gets N (1 - f) / (1 - f^L) f^l, the last level the rest.
+  const double f = 1.0 / options_.scale_factor;
+  double per_level = options_.num_features * (1.0 - f) / (1.0 - std::pow(f, levels));
+  int assigned = 0;
+  for (int l = 0; l < levels - 1; ++l) {
+    budgets_[static_cast<std::size_t>(l)] = static_cast<int>(std::lround(per_level));
+    assigned += budgets_[static_cast<std::size_t>(l)];
+    per_level *= f;
+  }
+  budgets_[static_cast<std::size_t>(levels) - 1] = std::max(0, options_.num_features - assigned);
+
+  pattern_ = make_brief_pattern(options_.patch_size);
+  pattern_offsets_.resize(pattern_.size() * 2);
+  const int r = options_.orientation_radius;
+  disc_half_width_.resize(static_cast<std::size_t>(r) + 1);
+  for (int v = 0; v <= r; ++v) {
+    disc_half_width_[static_cast<std::size_t>(v)] =
+        static_cast<int>(std::floor(std::sqrt(static_cast<double>(r * r - v * v)) + 0.5));
+  }
+  pyramid_.resize(static_cast<std::size_t>(levels));
+}
+
+void OrbExtractor::build_pyramid(const cv::Mat& gray) {
+  pyramid_[0] = gray;
+  for (int l = 1; l < options_.num_levels; ++l) {
+    const float s = scales_[static_cast<std::size_t>(l)];
+    const cv::Size size(static_cast<int>(std::lround(static_cast<float>(gray.cols) / s)),
+                        static_cast<int>(std::lround(static_cast<float>(gray.rows) / s)));
+    cv::Mat& dst = pyramid_[static_cast<std::size_t>(l)];
+    if (size.width <= 0 || size.height <= 0) {
+      dst.release();
+      continue;
+    }
+    if (dst.size() != size || dst.type() != CV_8UC1 || dst.data == gray.data) dst.create(size, CV_8UC1);
+    // Resizing the previous level is cheaper than resizing level 0 and is what ORB-SLAM does.
+    cv::resize(pyramid_[static_cast<std::size_t>(l) - 1], dst, size, 0, 0, cv::INTER_LINEAR);
+  }
+}
+
+// FAST once over the level at the low threshold (scores kept), then per cell: the corners scoring
+// >= fast_threshold where the cell has any, else all of them (>= fast_min_threshold).
+void OrbExtractor::detect_level(int level) {
+  candidates_.clear();
+  const cv::Mat& img = pyramid_[static_cast<std::size_t>(level)];
+  const int edge = options_.edge_threshold;
+  const int width = img.cols - 2 * edge, height = img.rows - 2 * edge;  // where corners may lie
+  if (img.empty() || width <= 0 || height <= 0) return;
+  detail::detect_fast(img, cv::Rect(edge, edge, width, height), options_.fast_min_threshold, fast_scores_, fast_);
+  if (fast_.empty()) return;
+
+  const int cols = std::max(1, width / options_.cell_size), rows = std::max(1, height / options_.cell_size);
+  // Cell of a corner, by integer arithmetic: cells split the region as evenly as possible.
+  auto cell_of = [&](const detail::FastCorner& k) {
+    const int cx = (k.x - edge) * cols / width, cy = (k.y - edge) * rows / height;
+    return static_cast<std::size_t>(cy * cols + cx);
+  };
+  cell_strong_.assign(static_cast<std::size_t>(cols * rows), 0);
+  const int strong = options_.fast_threshold;
+  for (const auto& k : fast_) {
+    if (k.score >= strong) cell_strong_[cell_of(k)] = 1;
+  }
+  candidates_.reserve(fast_.size());
+  for (const auto& k : fast_) {
+    if (k.score >= strong || cell_strong_[cell_of(k)] == 0) {
+      candidates_.push_back({static_cast<float>(k.x), static_cast<float>(k.y), static_cast<float>(k.score)});
+    }
+  }
+}
+
+// Quadtree over the candidates: split nodes (breadth first) until there are `target` nodes or every
+// node holds one corner; when a full round would overshoot, split the most populated nodes first. Each
+// node then contributes its strongest corner.
+void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
+  selected.clear();
+  if (candidates_.empty() || target <= 0) return;
+  const auto n = static_cast<int>(candidates_.size());
+  if (n <= target) {
+    selected.assign(candidates_.begin(), candidates_.end());
+    return;
+  }
+  float min_x = candidates_[0].x, max_x = min_x, min_y = candidates_[0].y, max_y = min_y;
+  for (const auto& c : candidates_) {
+    min_x = std::min(min_x, c.x);
+    max_x = std::max(max_x, c.x);
+    min_y = std::min(min_y, c.y);
+    max_y = std::max(max_y, c.y);
+  }
+  max_x += 1.0F;  // half-open boxes
+  max_y += 1.0F;
+  // Start from roughly square root nodes side by side, as wide images would otherwise split badly.
+  const int roots = std::max(1, static_cast<int>(std::lround((max_x - min_x) / (max_y - min_y))));
+  const float root_w = (max_x - min_x) / static_cast<float>(roots);
+  nodes_.clear();
+  {
+    // Stable bucketing into the roots (candidates arrive in row-major order, which is kept).
+    auto root_of = [&](const Candidate& c) {
+      return std::min(roots - 1, static_cast<int>((c.x - min_x) / root_w));
+    };
+    std::vector<int>& counts = root_counts_;
+    counts.assign(static_cast<std::size_t>(roots) + 1, 0);
+    for (const auto& c : candidates_) ++counts[static_cast<std::size_t>(root_of(c)) + 1];
+    for (std::size_t r = 1; r < counts.size(); ++r) counts[r] += counts[r - 1];
+    bucketed_.resize(candidates_.size());
+    std::vector<int> fill(counts.begin(), counts.end() - 1);
+    for (const auto& c : candidates_) {
+      bucketed_[static_cast<std::size_t>(fill[static_cast<std::size_t>(root_of(c))]++)] = c;
+    }
+    candidates_.swap(bucketed_);
+    for (int r = 0; r < roots; ++r) {
+      const int begin = counts[static_cast<std::size_t>(r)], end = counts[static_cast<std::size_t>(r) + 1];
+      if (end > begin) {
+        const float bx0 = min_x + root_w * static_cast<float>(r);
+        nodes_.push_back({bx0, min_y, r == roots - 1 ? max_x : bx0 + root_w, max_y, begin, end});
+      }
+    }
+  }
+  auto splittable = [](const Node& node) {
+    return node.end - node.begin > 1 && node.x1 - node.x0 > 1.0F && node.y1 - node.y0 > 1.0F;
+  };
+  auto split = [&](const Node& node, std::vector<Node>& out) {
+    const float xm = 0.5F * (node.x0 + node.x1), ym = 0.5F * (node.y0 + node.y1);
+    auto* first = candidates_.data() + node.begin;
+    auto* last = candidates_.data() + node.end;
+    auto* mid_y = std::partition(first, last, [ym](const Candidate& c) { return c.y < ym; });
+    auto* mid_top = std::partition(first, mid_y, [xm](const Candidate& c) { return c.x < xm; });
+    auto* mid_bottom = std::partition(mid_y, last, [xm](const Candidate& c) { return c.x < xm; });
+    const auto index = [&](const Candidate* p) { return static_cast<int>(p - candidates_.data()); };
+    const Node children[4] = {{node.x0, node.y0, xm, ym, index(first), index(mid_top)},
+                              {xm, node.y0, node.x1, ym, index(mid_top), index(mid_y)},
+                              {node.x0, ym, xm, node.y1, index(mid_y), index(mid_bottom)},
+                              {xm, ym, node.x1, node.y1, index(mid_bottom), index(last)}};
+    for (const Node& c : children) {
+      if (c.end > c.begin) out.push_back(c);
+    }
+  };
+  for (;;) {
+    if (static_cast<int>(nodes_.size()) >= target) break;
+    const auto expandable = static_cast<int>(std::count_if(nodes_.begin(), nodes_.end(), splittable));
+    if (expandable == 0) break;
+    if (static_cast<int>(nodes_.size()) + 3 * expandable < target) {
+      next_nodes_.clear();
+      for (const Node& node : nodes_) {
+        if (splittable(node)) {
+          split(node, next_nodes_);
+        } else {
+          next_nodes_.push_back(node);
+        }
+      }
+      nodes_.swap(next_nodes_);
+      continue;
+    }
+    // Last round: split the most populated nodes first, stopping as soon as the target is reached.
+    std::stable_sort(nodes_.begin(), nodes_.end(),
+                     [](const Node& a, const Node& b) { return a.end - a.begin > b.end - b.begin; });
+    next_nodes_.clear();
+    std::size_t i = 0;
+    for (; i < nodes_.size(); ++i) {
+      const std::size_t total = next_nodes_.size() + (nodes_.size() - i);
+      if (static_cast<int>(total) >= target) break;
+      if (splittable(nodes_[i])) {
+        split(nodes_[i], next_nodes_);
+      } else {
+        next_nodes_.push_back(nodes_[i]);
+      }
+    }
+    for (; i < nodes_.size(); ++i) next_nodes_.push_back(nodes_[i]);
+    nodes_.swap(next_nodes_);
+  }
+  selected.reserve(nodes_.size());
+  for (const Node& node : nodes_) {
+    const Candidate* best = &candidates_[static_cast<std::size_t>(node.begin)];
+    for (int j = node.begin + 1; j < node.end; ++j) {
+      const Candidate& c = candidates_[static_cast<std::size_t>(j)];
+      // Ties broken by position so that the result does not depend on partition order.
+      if (c.response > best->response ||
+          (c.response == best->response && (c.y < best->y || (c.y == best->y && c.x < best->x)))) {
+        best = &c;
+      }
+    }
+    selected.push_back(*best);
+  }
+  if (static_cast<int>(selected.size()) > target) {
+    std::stable_sort(selected.begin(), selected.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.response > b.response; });
+    selected.resize(static_cast<std::size_t>(target));
+  }
+}
+
+void OrbExtractor::describe_level(int level, std::span<const Candidate> selected, std::vector<Keypoint>& keypoints,
+                                  std::vector<Descriptor>& descriptors) {
+  if (selected.empty()) return;
+  const cv::Mat& img = pyramid_[static_cast<std::size_t>(level)];
+  cv::GaussianBlur(img, blurred_, cv::Size(options_.blur_size, options_.blur_size), options_.blur_sigma,
+                   options_.blur_sigma, cv::BORDER_REFLECT_101);
+  const float scale = scales_[static_cast<std::size_t>(level)];
+  const int r = options_.orientation_radius;
+  const auto step = static_cast<int>(img.step1());
+  const auto blurred_step = static_cast<int>(blurred_.step1());
+  constexpr float kRadToDeg = 180.0F / 3.14159265358979323846F;
+  constexpr float kDegToRad = 3.14159265358979323846F / 180.0F;
+  const std::size_t pairs = pattern_.size();
+  for (const Candidate& c : selected) {
+    const int cx = static_cast<int>(c.x), cy = static_cast<int>(c.y);
+    // Intensity centroid over the disc: rows +v and -v together.
+    const std::uint8_t* centre = img.ptr<std::uint8_t>(cy) + cx;
+    int m10 = 0, m01 = 0;
+    for (int u = -r; u <= r; ++u) m10 += u * centre[u];
+    for (int v = 1; v <= r; ++v) {
+      const int w = disc_half_width_[static_cast<std::size_t>(v)];
+      const std::uint8_t* below = centre + v * step;
+      const std::uint8_t* above = centre - v * step;
+      int sum_diff = 0, sum_x = 0;
+      for (int u = -w; u <= w; ++u) {
+        const int b = below[u], a = above[u];
+        sum_diff += b - a;
+        sum_x += u * (b + a);
+      }
+      m01 += v * sum_diff;
+      m10 += sum_x;
+    }
+    float angle = std::atan2(static_cast<float>(m01), static_cast<float>(m10)) * kRadToDeg;
+    if (angle < 0.0F) angle += 360.0F;
+    if (angle >= 360.0F) angle -= 360.0F;
+
+    // Rotate the pattern into the keypoint's frame, then compare smoothed intensities.
+    const float ca = std::cos(angle * kDegToRad), sa = std::sin(angle * kDegToRad);
+    for (std::size_t i = 0; i < pairs; ++i) {
+      const BriefPair& p = pattern_[i];
+      pattern_offsets_[2 * i] = round_to_int(p.x1 * sa + p.y1 * ca) * blurred_step + round_to_int(p.x1 * ca - p.y1 * sa);
+      pattern_offsets_[2 * i + 1] =
+          round_to_int(p.x2 * sa + p.y2 * ca) * blurred_step + round_to_int(p.x2 * ca - p.y2 * sa);
+    }
+    const std::uint8_t* bc = blurred_.ptr<std::uint8_t>(cy) + cx;
+    Descriptor d{};
+    for (std::size_t byte = 0; byte < 32; ++byte) {
+      unsigned bits = 0;
+      for (std::size_t bit = 0; bit < 8; ++bit) {
+        const std::size_t i = byte * 8 + bit;
+        bits |= static_cast<unsigned>(bc[pattern_offsets_[2 * i]] < bc[pattern_offsets_[2 * i + 1]]) << bit;
+      }
+      d[byte] = static_cast<std::uint8_t>(bits);
+    }
+    Keypoint k;
+    k.x = c.x * scale;
+    k.y = c.y * scale;
+    k.angle = angle;
+    k.response = c.response;
+    k.size = static_cast<float>(options_.patch_size) * scale;
+    k.level = level;
+    keypoints.push_back(k);
+    descriptors.push_back(d);
+  }
+}
+
+void OrbExtractor::extract(const cv::Mat& gray, std::vector<Keypoint>& keypoints,
+                           std::vector<Descriptor>& descriptors) {
+  require(!gray.empty() && gray.type() == CV_8UC1, "orb.image", "a non-empty 8-bit single-channel image");
+  keypoints.clear();
+  descriptors.clear();
+  keypoints.reserve(static_cast<std::size_t>(options_.num_features));
+  descriptors.reserve(static_cast<std::size_t>(options_.num_features));
+  build_pyramid(gray);
+  int carry = 0;  // a level's unused budget goes to the next one
+  for (int l = 0; l < options_.num_levels; ++l) {
+    const int target = budgets_[static_cast<std::size_t>(l)] + carry;
+    detect_level(l);
+    distribute(target, selected_);
+    carry = target - static_cast<int>(selected_.size());
+    describe_level(l, selected_, keypoints, descriptors);
+  }
+}
+
+}  // namespace rgbl
