@@ -1,0 +1,76 @@
+#pragma once
+// Depth completion by inverse dilation (SPEC section 3): every pixel takes the nearest valid depth
+// under a small kernel centred on it. One pass, no post-filter. Depth is camera z in metres, 0 = none.
+//
+// The result is bit-identical to the paper's OpenCV formulation (invert valid depths with M - d, grey
+// dilation, invert back with M - v, zero what maps back to M): the same float operations are applied,
+// so even the rounding of M - (M - d) matches. Depths must lie in (0, M); others count as empty.
+
+#include "rgbl/depth/depth_source.hpp"
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace rgbl {
+
+enum class KernelShape { diamond, rectangle, cross };
+
+// A symmetric kernel made of horizontal runs centred on column 0: row dy (in [-radius, radius]) covers
+// columns [-half_width(dy), half_width(dy)]. Diamonds, full rectangles and crosses are all of this form.
+class Kernel {
+ public:
+  // size is the odd side length (3, 5, 7, 9, ...). Throws ConfigError("kernel.size") otherwise.
+  Kernel(KernelShape shape, int size);
+
+  static Kernel diamond(int size) { return {KernelShape::diamond, size}; }
+  static Kernel rectangle(int size) { return {KernelShape::rectangle, size}; }
+  static Kernel cross(int size) { return {KernelShape::cross, size}; }
+
+  KernelShape shape() const { return shape_; }
+  int size() const { return 2 * radius_ + 1; }
+  int radius() const { return radius_; }
+  int half_width(int dy) const;
+  int cell_count() const;
+  // 0/1 CV_8U structuring element of size x size (for cv::dilate).
+  cv::Mat structuring_element() const;
+  // "diamond5", "rectangle3", "cross7"
+  std::string name() const;
+
+ private:
+  KernelShape shape_;
+  int radius_;
+};
+
+// Parses "diamond" / "rectangle" / "cross"; throws ConfigError(key) naming the choices otherwise.
+KernelShape parse_kernel_shape(std::string_view text, const char* key = "kernel.shape");
+
+struct DilationOptions {
+  KernelShape shape = KernelShape::diamond;
+  int size = 5;              // odd side length (paper: 5x5 diamond)
+  float max_depth = 200.0F;  // M, the inversion constant: depths must be < M (paper: the max range)
+
+  Kernel kernel() const { return {shape, size}; }
+  void validate() const;  // keys dilation.size, dilation.max_depth
+};
+
+// Dense inverse dilation of `sparse` into `dense` (allocated to sparse's size if needed; may not alias).
+void dilate_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, cv::Mat_<float>& dense);
+cv::Mat_<float> dilate_depth(const cv::Mat_<float>& sparse, const DilationOptions& options = {});
+
+// The completed depth at keypoint pixels without building the dense map: pixel (u, v) reads the cell
+// at the nearest pixel centre, and its z equals dense(round(v), round(u)) exactly. Also gives the
+// distance from (u, v) to the centre of the LiDAR sample that supplied z (the nearest one on ties) and
+// the spread (max - min) of the valid depths under the kernel. Pixels outside the image get z = 0.
+void lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions& options,
+                  std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out);
+KeypointDepth lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, const Eigen::Vector2f& pixel);
+
+// Share of pixels with depth (> 0), in [0, 1].
+double depth_density(const cv::Mat_<float>& depth);
+
+}  // namespace rgbl

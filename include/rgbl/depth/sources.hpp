@@ -1,0 +1,94 @@
+#pragma once
+// The built-in depth sources and the settings they are created from. Each source turns one frame's
+// sensor data into depth at keypoints (with the distance to the real measurement and the local depth
+// spread) and into a dense map on demand. Create them by name through DepthSourceRegistry.
+
+#include "rgbl/depth/completion.hpp"
+#include "rgbl/depth/depth_source.hpp"
+#include "rgbl/depth/ip_basic.hpp"
+#include "rgbl/geometry/calibration.hpp"
+#include "rgbl/geometry/projection.hpp"
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+namespace rgbl {
+
+enum class CompletionMethod { dilation, ip_basic_fast, ip_basic_multiscale };
+
+// Parses "dilation" / "ip_basic_fast" / "ip_basic_multiscale"; throws ConfigError(key) otherwise.
+CompletionMethod parse_completion_method(std::string_view text, const char* key = "lidar.completion");
+
+// `lidar`: the scan projected into the tracked camera (z-buffer), completed by inverse dilation (the
+// paper's 5x5 diamond by default) or by IP-Basic. With dilation, sample() reads keypoints straight
+// from the sparse image (no dense map).
+struct LidarSourceOptions {
+  ProjectionOptions projection{};
+  CompletionMethod completion = CompletionMethod::dilation;
+  DilationOptions dilation{};
+  IpBasicOptions ip_basic{};
+
+  void validate() const;
+};
+
+// `precomputed`: one uint16 PNG per frame (depth x 256, 0 = none), e.g. a network's output.
+struct PrecomputedSourceOptions {
+  std::filesystem::path folder;
+  std::string file_pattern = "{:06d}.png";  // fmt pattern of the frame index
+  double ignore_top_fraction = 0.3;         // paper: the upper 30% of network depth is unreliable
+  float max_depth = 80.0F;                  // depths beyond are dropped (KITTI depth GT ends at ~80 m)
+
+  void validate() const;
+};
+
+// `stereo`: OpenCV semi-global block matching on the rectified pair, depth = fx * baseline / disparity.
+struct StereoSourceOptions {
+  int num_disparities = 128;  // multiple of 16
+  int block_size = 5;         // odd
+  int uniqueness_ratio = 10;  // percent
+  int speckle_window = 100;
+  int speckle_range = 2;
+  float min_disparity_px = 1.0F;  // disparities below are dropped (depth too far to trust)
+  float max_depth = 80.0F;
+
+  void validate() const;
+};
+
+// `rgbd`: a depth camera's image, CV_16UC1 divided by `scale` (TUM: 5000, most others 1000) or
+// CV_32FC1 already in metres.
+struct RgbdSourceOptions {
+  double scale = 5000.0;
+  float max_depth = 10.0F;
+
+  void validate() const;
+};
+
+// What every depth source may need. Only the chosen source's options are validated on creation.
+struct DepthSourceSettings {
+  CameraCalibration calibration{};   // the tracked (rectified) camera
+  double stereo_baseline = 0.0;      // m, from the calibration (KittiCalibration::baseline)
+  LidarSourceOptions lidar{};
+  PrecomputedSourceOptions precomputed{};
+  StereoSourceOptions stereo{};
+  RgbdSourceOptions rgbd{};
+
+  void validate() const;  // the calibration only; each source validates its own options
+};
+
+std::unique_ptr<DepthSource> make_lidar_source(const DepthSourceSettings& settings);
+std::unique_ptr<DepthSource> make_precomputed_source(const DepthSourceSettings& settings);
+std::unique_ptr<DepthSource> make_stereo_source(const DepthSourceSettings& settings);
+std::unique_ptr<DepthSource> make_rgbd_source(const DepthSourceSettings& settings);
+
+// Reads a depth PNG (uint16, depth x 256) into metres. Throws ParseError naming the file.
+cv::Mat_<float> read_depth_png(const std::filesystem::path& file);
+// Writes metres as uint16 PNG (depth x 256, clamped to the uint16 range). Throws ParseError on failure.
+void write_depth_png(const std::filesystem::path& file, const cv::Mat_<float>& depth);
+
+// Depth at keypoints read from a dense map: z at the nearest pixel centre, sample_distance_px the
+// distance to that centre, spread over `kernel` around it. Used by the sources without a sparse input.
+void sample_dense_depth(const cv::Mat_<float>& dense, const Kernel& kernel, std::span<const Eigen::Vector2f> pixels,
+                        std::span<KeypointDepth> out);
+
+}  // namespace rgbl

@@ -1,0 +1,309 @@
+#include "rgbl/depth/sources.hpp"
+
+#include "rgbl/core/error.hpp"
+
+#include <fmt/format.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rgbl {
+
+CompletionMethod parse_completion_method(std::string_view text, const char* key) {
+  if (text == "dilation") return CompletionMethod::dilation;
+  if (text == "ip_basic_fast") return CompletionMethod::ip_basic_fast;
+  if (text == "ip_basic_multiscale") return CompletionMethod::ip_basic_multiscale;
+  throw ConfigError(key, "one of: dilation, ip_basic_fast, ip_basic_multiscale");
+}
+
+void LidarSourceOptions::validate() const {
+  projection.validate();
+  dilation.validate();
+  ip_basic.validate();
+}
+
+void PrecomputedSourceOptions::validate() const {
+  require(!folder.empty(), "precomputed.folder", "the folder holding the depth PNGs");
+  require(!file_pattern.empty(), "precomputed.file_pattern", "a file name pattern such as {:06d}.png");
+  require(ignore_top_fraction >= 0.0 && ignore_top_fraction < 1.0, "precomputed.ignore_top_fraction",
+          "a fraction in [0, 1)");
+  require(max_depth > 0.0F, "precomputed.max_depth", "a depth > 0 m");
+}
+
+void StereoSourceOptions::validate() const {
+  require(num_disparities >= 16 && num_disparities % 16 == 0, "stereo.num_disparities", "a positive multiple of 16");
+  require(block_size >= 1 && block_size % 2 == 1 && block_size <= 11, "stereo.block_size", "an odd size in [1, 11]");
+  require(uniqueness_ratio >= 0 && uniqueness_ratio <= 100, "stereo.uniqueness_ratio", "a percentage in [0, 100]");
+  require(speckle_window >= 0, "stereo.speckle_window", "a size >= 0");
+  require(speckle_range >= 0, "stereo.speckle_range", "a disparity range >= 0");
+  require(min_disparity_px > 0.0F, "stereo.min_disparity_px", "a disparity > 0 px");
+  require(max_depth > 0.0F, "stereo.max_depth", "a depth > 0 m");
+}
+
+void RgbdSourceOptions::validate() const {
+  require(scale > 0.0 && std::isfinite(scale), "rgbd.scale", "a positive factor (units per metre, e.g. 5000)");
+  require(max_depth > 0.0F, "rgbd.max_depth", "a depth > 0 m");
+}
+
+void DepthSourceSettings::validate() const { calibration.camera.validate(); }
+
+cv::Mat_<float> read_depth_png(const std::filesystem::path& file) {
+  if (!std::filesystem::exists(file)) throw ParseError(file, 0, "a depth PNG (uint16, depth x 256); the file does not exist");
+  const cv::Mat raw = cv::imread(file.string(), cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
+  if (raw.empty() || raw.type() != CV_16UC1) throw ParseError(file, 0, "a single-channel uint16 PNG (depth x 256)");
+  cv::Mat_<float> depth;
+  raw.convertTo(depth, CV_32F, 1.0 / 256.0);
+  return depth;
+}
+
+void write_depth_png(const std::filesystem::path& file, const cv::Mat_<float>& depth) {
+  cv::Mat raw;
+  depth.convertTo(raw, CV_16U, 256.0);  // saturating
+  if (!cv::imwrite(file.string(), raw)) throw ParseError(file, 0, "a writable PNG path");
+}
+
+void sample_dense_depth(const cv::Mat_<float>& dense, const Kernel& kernel, std::span<const Eigen::Vector2f> pixels,
+                        std::span<KeypointDepth> out) {
+  CV_Assert(out.size() == pixels.size());
+  const int radius = kernel.radius();
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    KeypointDepth& result = out[i];
+    result = {};
+    const Eigen::Vector2f& p = pixels[i];
+    const float fx = std::floor(p.x() + 0.5F), fy = std::floor(p.y() + 0.5F);
+    if (!(fx >= 0.0F && fy >= 0.0F && fx < static_cast<float>(dense.cols) && fy < static_cast<float>(dense.rows))) continue;
+    const int x = static_cast<int>(fx), y = static_cast<int>(fy);
+    const float z = dense(y, x);
+    if (!(z > 0.0F)) continue;
+    float lo = z, hi = z;
+    for (int dy = -radius; dy <= radius; ++dy) {
+      const int r = y + dy;
+      if (r < 0 || r >= dense.rows) continue;
+      const int h = kernel.half_width(dy);
+      for (int c = std::max(0, x - h); c <= std::min(dense.cols - 1, x + h); ++c) {
+        const float d = dense(r, c);
+        if (d > 0.0F) {
+          lo = std::min(lo, d);
+          hi = std::max(hi, d);
+        }
+      }
+    }
+    result.z = z;
+    result.sample_distance_px = (p - Eigen::Vector2f(fx, fy)).norm();
+    result.spread = hi - lo;
+  }
+}
+
+namespace {
+
+void require_size(const cv::Mat& image, const PinholeCamera& camera, const char* what) {
+  if (image.cols != camera.width || image.rows != camera.height) {
+    throw ConfigError(what, fmt::format("an image of the camera's size {}x{} (got {}x{})", camera.width,
+                                        camera.height, image.cols, image.rows));
+  }
+}
+
+// Distance from `p` to the nearest non-zero pixel centre of `sparse` within `radius`; radius + 1 if none.
+float nearest_sample_distance(const cv::Mat_<float>& sparse, const Eigen::Vector2f& p, int radius) {
+  const int x = static_cast<int>(std::floor(p.x() + 0.5F)), y = static_cast<int>(std::floor(p.y() + 0.5F));
+  float best2 = std::numeric_limits<float>::max();
+  for (int r = std::max(0, y - radius); r <= std::min(sparse.rows - 1, y + radius); ++r) {
+    for (int c = std::max(0, x - radius); c <= std::min(sparse.cols - 1, x + radius); ++c) {
+      if (!(sparse(r, c) > 0.0F)) continue;
+      const float ex = static_cast<float>(c) - p.x(), ey = static_cast<float>(r) - p.y();
+      best2 = std::min(best2, ex * ex + ey * ey);
+    }
+  }
+  return best2 == std::numeric_limits<float>::max() ? static_cast<float>(radius + 1) : std::sqrt(best2);
+}
+
+class LidarDepthSource final : public DepthSource {
+ public:
+  explicit LidarDepthSource(const DepthSourceSettings& settings)
+      : camera_(settings.calibration.camera), P_img_lidar_(settings.calibration.P_img_lidar()),
+        options_(settings.lidar) {
+    options_.validate();
+  }
+
+  std::string_view name() const override { return "lidar"; }
+
+  void prepare(const SensorFrame& frame) override {
+    if (frame.scan.empty()) throw ConfigError("frame.scan", "a LiDAR scan for the lidar depth source");
+    sparse_.create(camera_.height, camera_.width);
+    project_to_depth(frame.scan, P_img_lidar_, options_.projection, sparse_);
+    dense_.release();
+    if (options_.completion != CompletionMethod::dilation) dense_ = complete();
+  }
+
+  void sample(std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) const override {
+    if (options_.completion == CompletionMethod::dilation) {
+      lookup_depth(sparse_, options_.dilation, pixels, out);
+      return;
+    }
+    sample_dense_depth(dense_, options_.dilation.kernel(), pixels, out);
+    // IP-Basic fills from up to 15 px away: report the distance to the nearest real sample instead.
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      if (out[i].z > 0.0F) out[i].sample_distance_px = nearest_sample_distance(sparse_, pixels[i], 15);
+    }
+  }
+
+  cv::Mat_<float> dense_depth() const override {
+    if (options_.completion == CompletionMethod::dilation) return complete();
+    return dense_.clone();
+  }
+
+ private:
+  cv::Mat_<float> complete() const {
+    switch (options_.completion) {
+      case CompletionMethod::dilation: return dilate_depth(sparse_, options_.dilation);
+      case CompletionMethod::ip_basic_fast: return ip_basic_fast(sparse_, options_.ip_basic);
+      case CompletionMethod::ip_basic_multiscale: return ip_basic_multiscale(sparse_, options_.ip_basic);
+    }
+    return {};
+  }
+
+  PinholeCamera camera_;
+  Matrix34d P_img_lidar_;
+  LidarSourceOptions options_;
+  cv::Mat_<float> sparse_;
+  cv::Mat_<float> dense_;  // only for the dense completion methods
+};
+
+// Shared by the sources that produce a dense map per frame in prepare().
+class DenseDepthSource : public DepthSource {
+ public:
+  void sample(std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) const override {
+    sample_dense_depth(depth_, Kernel::diamond(5), pixels, out);
+  }
+  cv::Mat_<float> dense_depth() const override { return depth_.clone(); }
+
+ protected:
+  cv::Mat_<float> depth_;
+};
+
+class PrecomputedDepthSource final : public DenseDepthSource {
+ public:
+  explicit PrecomputedDepthSource(const DepthSourceSettings& settings)
+      : camera_(settings.calibration.camera), options_(settings.precomputed) {
+    options_.validate();
+  }
+
+  std::string_view name() const override { return "precomputed"; }
+
+  void prepare(const SensorFrame& frame) override {
+    const auto file = options_.folder / fmt::format(fmt::runtime(options_.file_pattern), frame.index);
+    depth_ = read_depth_png(file);
+    if (depth_.cols != camera_.width || depth_.rows != camera_.height) {
+      throw ParseError(file, 0, fmt::format("a depth PNG of the camera's size {}x{} (got {}x{})", camera_.width,
+                                            camera_.height, depth_.cols, depth_.rows));
+    }
+    const int ignored = static_cast<int>(std::lround(options_.ignore_top_fraction * depth_.rows));
+    depth_.rowRange(0, ignored).setTo(0.0F);
+    depth_.setTo(0.0F, depth_ > options_.max_depth);
+  }
+
+ private:
+  PinholeCamera camera_;
+  PrecomputedSourceOptions options_;
+};
+
+class StereoDepthSource final : public DenseDepthSource {
+ public:
+  explicit StereoDepthSource(const DepthSourceSettings& settings)
+      : camera_(settings.calibration.camera), baseline_(settings.stereo_baseline), options_(settings.stereo) {
+    options_.validate();
+    require(baseline_ > 0.0 && std::isfinite(baseline_), "stereo_baseline", "the stereo baseline in metres (> 0)");
+    const int area = options_.block_size * options_.block_size;
+    matcher_ = cv::StereoSGBM::create(0, options_.num_disparities, options_.block_size, 8 * area, 32 * area, 1,
+                                      0, options_.uniqueness_ratio, options_.speckle_window, options_.speckle_range,
+                                      cv::StereoSGBM::MODE_SGBM_3WAY);
+  }
+
+  std::string_view name() const override { return "stereo"; }
+
+  void prepare(const SensorFrame& frame) override {
+    if (frame.image.empty() || frame.image_right.empty()) {
+      throw ConfigError("frame.image_right", "a rectified stereo pair (image and image_right) for the stereo source");
+    }
+    require_size(frame.image, camera_, "frame.image");
+    require_size(frame.image_right, camera_, "frame.image_right");
+    matcher_->compute(grey(frame.image), grey(frame.image_right), disparity_);
+    depth_.create(disparity_.rows, disparity_.cols);
+    const float fb = static_cast<float>(camera_.fx * baseline_);
+    for (int y = 0; y < disparity_.rows; ++y) {
+      const auto* disparity = disparity_.ptr<std::int16_t>(y);
+      float* out = depth_[y];
+      for (int x = 0; x < disparity_.cols; ++x) {
+        const float d = static_cast<float>(disparity[x]) * (1.0F / 16.0F);  // SGBM: 4 fractional bits
+        const float z = d >= options_.min_disparity_px ? fb / d : 0.0F;
+        out[x] = z <= options_.max_depth ? z : 0.0F;
+      }
+    }
+  }
+
+ private:
+  static cv::Mat grey(const cv::Mat& image) {
+    if (image.channels() == 1) return image;
+    cv::Mat out;
+    cv::cvtColor(image, out, cv::COLOR_BGR2GRAY);
+    return out;
+  }
+
+  PinholeCamera camera_;
+  double baseline_;
+  StereoSourceOptions options_;
+  cv::Ptr<cv::StereoSGBM> matcher_;
+  cv::Mat disparity_;
+};
+
+class RgbdDepthSource final : public DenseDepthSource {
+ public:
+  explicit RgbdDepthSource(const DepthSourceSettings& settings)
+      : camera_(settings.calibration.camera), options_(settings.rgbd) {
+    options_.validate();
+  }
+
+  std::string_view name() const override { return "rgbd"; }
+
+  void prepare(const SensorFrame& frame) override {
+    if (frame.depth_image.empty()) throw ConfigError("frame.depth_image", "a depth image for the rgbd source");
+    require_size(frame.depth_image, camera_, "frame.depth_image");
+    if (frame.depth_image.type() == CV_16UC1) {
+      frame.depth_image.convertTo(depth_, CV_32F, 1.0 / options_.scale);
+    } else if (frame.depth_image.type() == CV_32FC1) {
+      frame.depth_image.copyTo(depth_);
+    } else {
+      throw ConfigError("frame.depth_image", "a CV_16UC1 (scaled) or CV_32FC1 (metres) depth image");
+    }
+    // NaN (no return in some float formats) and out-of-range values become "no depth"
+    for (int y = 0; y < depth_.rows; ++y) {
+      float* row = depth_[y];
+      for (int x = 0; x < depth_.cols; ++x) row[x] = (row[x] > 0.0F && row[x] <= options_.max_depth) ? row[x] : 0.0F;
+    }
+  }
+
+ private:
+  PinholeCamera camera_;
+  RgbdSourceOptions options_;
+};
+
+}  // namespace
+
+std::unique_ptr<DepthSource> make_lidar_source(const DepthSourceSettings& settings) {
+  return std::make_unique<LidarDepthSource>(settings);
+}
+std::unique_ptr<DepthSource> make_precomputed_source(const DepthSourceSettings& settings) {
+  return std::make_unique<PrecomputedDepthSource>(settings);
+}
+std::unique_ptr<DepthSource> make_stereo_source(const DepthSourceSettings& settings) {
+  return std::make_unique<StereoDepthSource>(settings);
+}
+std::unique_ptr<DepthSource> make_rgbd_source(const DepthSourceSettings& settings) {
+  return std::make_unique<RgbdDepthSource>(settings);
+}
+
+}  // namespace rgbl

@@ -1,0 +1,168 @@
+#include "bench/reference/dilation_reference.hpp"
+#include "rgbl/core/error.hpp"
+#include "rgbl/depth/completion.hpp"
+#include "rgbl/geometry/calibration.hpp"
+#include "rgbl/geometry/projection.hpp"
+#include "support/data.hpp"
+
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+#include <opencv2/core.hpp>
+
+#include <cstring>
+#include <random>
+
+namespace {
+
+bool bit_identical(const cv::Mat_<float>& a, const cv::Mat_<float>& b) {
+  if (a.size() != b.size()) return false;
+  for (int y = 0; y < a.rows; ++y) {
+    if (std::memcmp(a[y], b[y], sizeof(float) * static_cast<std::size_t>(a.cols)) != 0) return false;
+  }
+  return true;
+}
+
+cv::Mat_<float> reference(const cv::Mat_<float>& sparse, const rgbl::DilationOptions& o) {
+  cv::Mat dense;
+  rgbl::reference::inverse_dilation(sparse, o.kernel().structuring_element(), o.max_depth, dense);
+  return dense;
+}
+
+std::vector<rgbl::DilationOptions> all_kernels() {
+  std::vector<rgbl::DilationOptions> out;
+  for (int size : {3, 5, 7, 9}) out.push_back({rgbl::KernelShape::diamond, size, 200.0F});
+  for (int size : {3, 5}) out.push_back({rgbl::KernelShape::rectangle, size, 200.0F});
+  for (int size : {3, 5, 7}) out.push_back({rgbl::KernelShape::cross, size, 200.0F});
+  return out;
+}
+
+cv::Mat_<float> project_frame(const std::filesystem::path& seq, int frame) {
+  const auto calib = rgbl::read_kitti_odometry_calibration(seq / "calib.txt", 1226, 370).camera(2);
+  const auto scan = rgbl::read_kitti_scan(seq / "velodyne" / fmt::format("{:06d}.bin", frame));
+  return rgbl::project_to_depth(scan, calib.P_img_lidar(), 1226, 370);
+}
+
+}  // namespace
+
+TEST_CASE("kernels have the documented cells") {
+  CHECK(rgbl::Kernel::diamond(5).cell_count() == 13);
+  CHECK(rgbl::Kernel::diamond(3).cell_count() == 5);
+  CHECK(rgbl::Kernel::diamond(9).cell_count() == 41);
+  CHECK(rgbl::Kernel::rectangle(5).cell_count() == 25);
+  CHECK(rgbl::Kernel::cross(7).cell_count() == 13);
+  const cv::Mat e = rgbl::Kernel::diamond(5).structuring_element();
+  const cv::Mat expected = (cv::Mat_<std::uint8_t>(5, 5) << 0, 0, 1, 0, 0, 0, 1, 1, 1, 0, 1, 1, 1, 1, 1, 0, 1, 1, 1,
+                            0, 0, 0, 1, 0, 0);
+  CHECK(cv::countNonZero(e != expected) == 0);
+  CHECK(rgbl::Kernel::cross(3).name() == "cross3");
+  CHECK_THROWS_AS(rgbl::Kernel(rgbl::KernelShape::diamond, 4), rgbl::ConfigError);
+  CHECK(rgbl::parse_kernel_shape("rectangle") == rgbl::KernelShape::rectangle);
+  CHECK_THROWS_WITH(rgbl::parse_kernel_shape("ellipse"), Catch::Contains("diamond, rectangle, cross"));
+  rgbl::DilationOptions bad;
+  bad.max_depth = 0.0F;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("dilation.max_depth"));
+  bad = {};
+  bad.size = 6;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("dilation.size"));
+}
+
+TEST_CASE("a single point dilates to exactly the 13-cell diamond") {
+  cv::Mat_<float> sparse(20, 30, 0.0F);
+  sparse(10, 15) = 12.5F;
+  const cv::Mat_<float> dense = rgbl::dilate_depth(sparse);
+  CHECK(cv::countNonZero(dense) == 13);
+  for (int y = 0; y < dense.rows; ++y) {
+    for (int x = 0; x < dense.cols; ++x) {
+      const bool inside = std::abs(x - 15) + std::abs(y - 10) <= 2;
+      INFO("pixel " << x << ", " << y);
+      CHECK(dense(y, x) == (inside ? 12.5F : 0.0F));  // 200 - (200 - 12.5) is exact
+    }
+  }
+  // at a corner only the in-image part remains: 6 cells of the diamond
+  cv::Mat_<float> corner(20, 30, 0.0F);
+  corner(0, 0) = 7.0F;
+  CHECK(cv::countNonZero(rgbl::dilate_depth(corner)) == 6);
+}
+
+TEST_CASE("the nearer depth wins where kernels overlap") {
+  cv::Mat_<float> sparse(10, 10, 0.0F);
+  sparse(5, 3) = 30.0F;
+  sparse(5, 6) = 10.0F;
+  const cv::Mat_<float> dense = rgbl::dilate_depth(sparse);
+  CHECK(dense(5, 4) == 10.0F);  // 1 px from the far point, 2 px from the near one
+  CHECK(dense(5, 5) == 10.0F);
+  CHECK(dense(5, 2) == 30.0F);
+  CHECK(dense(5, 1) == 30.0F);
+  CHECK(dense(5, 3) == 30.0F);  // the far sample itself is 3 px away from the near one: kept
+  CHECK(dense(4, 4) == 30.0F);  // L1 distance 2 to the far point, 3 to the near one
+  CHECK(dense(4, 5) == 10.0F);
+  // keypoint lookup: value, distance to its source, spread
+  const auto k = rgbl::lookup_depth(sparse, {}, Eigen::Vector2f(4.0F, 5.0F));
+  CHECK(k.z == 10.0F);
+  CHECK(k.sample_distance_px == Approx(2.0F));
+  CHECK(k.spread == Approx(20.0F));
+  const auto subpixel = rgbl::lookup_depth(sparse, {}, Eigen::Vector2f(5.8F, 5.4F));  // reads cell (6, 5)
+  CHECK(subpixel.z == 10.0F);
+  CHECK(subpixel.sample_distance_px == Approx(std::hypot(0.2F, 0.4F)));
+  CHECK(subpixel.spread == 0.0F);
+  CHECK(rgbl::lookup_depth(sparse, {}, Eigen::Vector2f(-3.0F, 5.0F)).z == 0.0F);
+  CHECK(rgbl::lookup_depth(sparse, {}, Eigen::Vector2f(0.0F, 0.0F)).z == 0.0F);
+}
+
+TEST_CASE("depths the inversion cannot hold count as empty, like the reference") {
+  cv::Mat_<float> sparse(8, 8, 0.0F);
+  sparse(2, 2) = 250.0F;   // beyond M
+  sparse(5, 5) = -3.0F;    // negative
+  sparse(6, 1) = 199.99999F;
+  for (const auto& o : all_kernels()) CHECK(bit_identical(rgbl::dilate_depth(sparse, o), reference(sparse, o)));
+}
+
+TEST_CASE("dilation equals the OpenCV reference bit for bit on random sparse images") {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> depth(5.0F, 199.0F);
+  std::uniform_real_distribution<float> coin(0.0F, 1.0F);
+  for (const float fill : {0.01F, 0.04F, 0.3F, 1.0F}) {
+    cv::Mat_<float> sparse(37, 61, 0.0F);
+    for (auto& d : sparse) d = coin(rng) < fill ? depth(rng) : 0.0F;
+    for (const auto& o : all_kernels()) {
+      INFO(o.kernel().name() << " fill " << fill);
+      CHECK(bit_identical(rgbl::dilate_depth(sparse, o), reference(sparse, o)));
+    }
+  }
+}
+
+TEST_CASE("dilation equals the reference and keypoint lookup equals the dense map on real frames") {
+  const auto seq = rgbl::test::kitti_seq04();
+  if (!seq) return;
+  std::mt19937 rng(3);
+  for (const int frame : {0, 25, 50}) {
+    const cv::Mat_<float> sparse = project_frame(*seq, frame);
+    for (const auto& o : all_kernels()) {
+      INFO("frame " << frame << " " << o.kernel().name());
+      const cv::Mat_<float> dense = rgbl::dilate_depth(sparse, o);
+      REQUIRE(bit_identical(dense, reference(sparse, o)));
+      // every pixel of the image, at random sub-pixel offsets within its cell
+      std::uniform_real_distribution<float> jitter(-0.49F, 0.49F);
+      std::vector<Eigen::Vector2f> pixels;
+      for (int y = 0; y < dense.rows; ++y)
+        for (int x = 0; x < dense.cols; ++x) pixels.emplace_back(static_cast<float>(x) + jitter(rng), static_cast<float>(y) + jitter(rng));
+      std::vector<rgbl::KeypointDepth> depths(pixels.size());
+      rgbl::lookup_depth(sparse, o, pixels, depths);
+      std::size_t mismatches = 0;
+      for (std::size_t i = 0; i < pixels.size(); ++i) {
+        const int x = static_cast<int>(i % static_cast<std::size_t>(dense.cols));
+        const int y = static_cast<int>(i / static_cast<std::size_t>(dense.cols));
+        mismatches += std::memcmp(&depths[i].z, &dense(y, x), sizeof(float)) != 0 ? 1U : 0U;
+      }
+      CHECK(mismatches == 0);
+    }
+  }
+}
+
+TEST_CASE("density counts pixels with depth") {
+  cv::Mat_<float> d(4, 5, 0.0F);
+  d(0, 0) = 1.0F;
+  d(3, 4) = 2.0F;
+  CHECK(rgbl::depth_density(d) == Approx(0.1));
+  CHECK(rgbl::depth_density(cv::Mat_<float>()) == 0.0);
+}

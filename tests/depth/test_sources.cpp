@@ -1,0 +1,132 @@
+#include "rgbl/core/error.hpp"
+#include "rgbl/depth/completion.hpp"
+#include "rgbl/depth/registry.hpp"
+#include "rgbl/geometry/calibration.hpp"
+#include "support/data.hpp"
+#include "support/temp_dir.hpp"
+
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+#include <opencv2/core.hpp>
+
+#include <cstring>
+
+using Catch::Matchers::Contains;
+
+namespace {
+
+// LiDAR frame == camera frame, f = 100 px, 64x48 image, principal point (32, 24).
+rgbl::DepthSourceSettings simple_settings() {
+  rgbl::DepthSourceSettings s;
+  s.calibration.camera.fx = s.calibration.camera.fy = 100.0;
+  s.calibration.camera.cx = 32.0;
+  s.calibration.camera.cy = 24.0;
+  s.calibration.camera.width = 64;
+  s.calibration.camera.height = 48;
+  s.lidar.projection.min_depth = 1.0F;
+  return s;
+}
+
+rgbl::DepthSourceSettings kitti_settings(const std::filesystem::path& seq) {
+  const auto kitti = rgbl::read_kitti_odometry_calibration(seq / "calib.txt", 1226, 370);
+  rgbl::DepthSourceSettings s;
+  s.calibration = kitti.camera(2);
+  s.stereo_baseline = kitti.baseline(2, 3);
+  return s;
+}
+
+class ConstantSource final : public rgbl::DepthSource {
+ public:
+  explicit ConstantSource(float z) : z_(z) {}
+  std::string_view name() const override { return "constant"; }
+  void prepare(const rgbl::SensorFrame&) override {}
+  void sample(std::span<const Eigen::Vector2f>, std::span<rgbl::KeypointDepth> out) const override {
+    for (auto& k : out) k.z = z_;
+  }
+  cv::Mat_<float> dense_depth() const override { return {}; }
+
+ private:
+  float z_;
+};
+
+}  // namespace
+
+TEST_CASE("registry: built-ins, unknown names and user sources") {
+  auto registry = rgbl::DepthSourceRegistry::with_builtins();
+  CHECK(registry.names() == std::vector<std::string>{"lidar", "precomputed", "rgbd", "stereo"});
+  try {
+    (void)registry.create("neural", simple_settings());
+    FAIL("expected a ConfigError");
+  } catch (const rgbl::ConfigError& e) {
+    CHECK(e.key() == "depth.source");
+    CHECK_THAT(e.what(), Contains("lidar, precomputed, rgbd, stereo") && Contains("neural"));
+  }
+  registry.add("constant", [](const rgbl::DepthSourceSettings&) { return std::make_unique<ConstantSource>(4.0F); });
+  auto source = registry.create("constant", simple_settings());
+  REQUIRE(source != nullptr);
+  CHECK(source->name() == "constant");
+  const std::vector<Eigen::Vector2f> pixels = {{1.0F, 2.0F}};
+  std::vector<rgbl::KeypointDepth> out(1);
+  source->sample(pixels, out);
+  CHECK(out[0].z == 4.0F);
+  CHECK_THROWS_AS(registry.add("", {}), rgbl::ConfigError);
+  auto bad = simple_settings();
+  bad.calibration.camera.fx = 0.0;
+  CHECK_THROWS_AS(registry.create("lidar", bad), rgbl::ConfigError);
+}
+
+TEST_CASE("lidar source: projects, samples keypoints and agrees with its dense map") {
+  const auto registry = rgbl::DepthSourceRegistry::with_builtins();
+  auto source = registry.create("lidar", simple_settings());
+  CHECK(source->name() == "lidar");
+  CHECK_THROWS_WITH(source->prepare({}), Contains("frame.scan"));
+  const std::vector<rgbl::LidarPoint> scan = {{0.0F, 0.0F, 10.0F, 0.0F}, {0.3F, 0.0F, 20.0F, 0.0F}};  // (32,24), (33.5->34,24)
+  rgbl::SensorFrame frame;
+  frame.scan = scan;
+  source->prepare(frame);
+  const std::vector<Eigen::Vector2f> pixels = {{33.0F, 24.0F}, {36.0F, 24.0F}, {10.0F, 10.0F}};
+  std::vector<rgbl::KeypointDepth> out(pixels.size());
+  source->sample(pixels, out);
+  CHECK(out[0].z == 10.0F);
+  CHECK(out[0].sample_distance_px == Approx(1.0F));
+  CHECK(out[0].spread == Approx(10.0F));
+  CHECK(out[1].z == 20.0F);
+  CHECK(out[1].sample_distance_px == Approx(2.0F));
+  CHECK(out[2].z == 0.0F);
+  const cv::Mat_<float> dense = source->dense_depth();
+  CHECK(cv::countNonZero(dense) == 13 + 13 - 5);  // two diamonds 2 px apart share 5 cells
+  CHECK(dense(24, 33) == 10.0F);
+  CHECK(dense(24, 35) == 20.0F);
+}
+
+TEST_CASE("lidar source on real frames: keypoint samples equal the dense map") {
+  const auto seq = rgbl::test::kitti_seq04();
+  if (!seq) return;
+  const auto settings = kitti_settings(*seq);
+  auto source = rgbl::DepthSourceRegistry::with_builtins().create("lidar", settings);
+  const auto scan = rgbl::read_kitti_scan(*seq / "velodyne" / "000010.bin");
+  rgbl::SensorFrame frame;
+  frame.index = 10;
+  frame.scan = scan;
+  source->prepare(frame);
+  const cv::Mat_<float> dense = source->dense_depth();
+  CHECK(rgbl::depth_density(dense) > 0.2);
+  std::vector<Eigen::Vector2f> pixels;
+  for (int y = 0; y < dense.rows; y += 3)
+    for (int x = 0; x < dense.cols; x += 2) pixels.emplace_back(static_cast<float>(x) + 0.3F, static_cast<float>(y) - 0.4F);
+  std::vector<rgbl::KeypointDepth> out(pixels.size());
+  source->sample(pixels, out);
+  std::size_t mismatches = 0, with_depth = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    const float expected = dense(static_cast<int>(std::floor(pixels[i].y() + 0.5F)), static_cast<int>(std::floor(pixels[i].x() + 0.5F)));
+    mismatches += std::memcmp(&expected, &out[i].z, sizeof(float)) != 0 ? 1U : 0U;
+    if (out[i].z > 0.0F) {
+      ++with_depth;
+      // the farthest diamond cell from (x + 0.3, y - 0.4) is (x, y + 2)
+      CHECK(out[i].sample_distance_px <= std::hypot(0.3F, 2.4F) + 1e-4F);
+      CHECK(out[i].spread >= 0.0F);
+    }
+  }
+  CHECK(mismatches == 0);
+  CHECK(with_depth > pixels.size() / 5);
+}
