@@ -1,6 +1,6 @@
 #pragma once
-// Development harness shared by rgbl_track_kitti and the tracking tests: a minimal LiDAR depth source
-// (stand-in until the depth module's `lidar` source is merged), KITTI pose reading, ATE and drift.
+// Development harness shared by rgbl_track_kitti and the tracking tests: runs the System with the
+// `lidar` depth source and rgbl's ORB extractor on a KITTI sequence; KITTI pose reading, ATE and drift.
 // Header-only on purpose: it is not part of the library.
 
 #include "rgbl/core/error.hpp"
@@ -9,7 +9,8 @@
 #include "rgbl/geometry/calibration.hpp"
 #include "rgbl/geometry/point_cloud.hpp"
 #include "rgbl/geometry/projection.hpp"
-#include "rgbl/tracking/opencv_orb.hpp"
+#include "rgbl/depth/sources.hpp"
+#include "rgbl/features/orb.hpp"
 #include "rgbl/tracking/system.hpp"
 
 #include <Eigen/Geometry>
@@ -26,51 +27,6 @@
 #include <vector>
 
 namespace rgbl::dev {
-
-// Projection + keypoint-only lookup under the 5x5 diamond: the nearest valid depth wins (what inverse
-// dilation gives), with the distance to that sample and the spread of depths under the kernel.
-class LidarDepthStandIn final : public DepthSource {
- public:
-  explicit LidarDepthStandIn(CameraCalibration calibration)
-      : P_(calibration.P_img_lidar()), width_(calibration.camera.width), height_(calibration.camera.height) {}
-
-  std::string_view name() const override { return "lidar-standin"; }
-
-  void prepare(const SensorFrame& frame) override {
-    if (frame.scan.empty()) throw Error("lidar depth: the frame has no LiDAR scan");
-    if (sparse_.rows != height_ || sparse_.cols != width_) sparse_.create(height_, width_);
-    project_to_depth(frame.scan, P_, ProjectionOptions{}, sparse_);
-  }
-
-  void sample(std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) const override {
-    static constexpr int kOffsets[13][2] = {{0, -2}, {-1, -1}, {0, -1}, {1, -1}, {-2, 0}, {-1, 0}, {0, 0},
-                                            {1, 0},  {2, 0},   {-1, 1}, {0, 1},  {1, 1},  {0, 2}};
-    for (std::size_t i = 0; i < pixels.size(); ++i) {
-      const int u = static_cast<int>(std::lround(pixels[i].x()));
-      const int v = static_cast<int>(std::lround(pixels[i].y()));
-      float zmin = 0.0F, zmax = 0.0F, dist = 0.0F;
-      for (const auto& o : kOffsets) {
-        const int x = u + o[0], y = v + o[1];
-        if (x < 0 || y < 0 || x >= width_ || y >= height_) continue;
-        const float z = sparse_(y, x);
-        if (z <= 0.0F) continue;
-        if (zmin == 0.0F || z < zmin) {
-          zmin = z;
-          dist = std::hypot(pixels[i].x() - static_cast<float>(x), pixels[i].y() - static_cast<float>(y));
-        }
-        zmax = std::max(zmax, z);
-      }
-      out[i] = KeypointDepth{zmin, dist, zmax - zmin};
-    }
-  }
-
-  cv::Mat_<float> dense_depth() const override { return sparse_.clone(); }
-
- private:
-  Matrix34d P_;
-  int width_, height_;
-  cv::Mat_<float> sparse_;
-};
 
 inline std::vector<Eigen::Isometry3d> read_kitti_poses(const std::filesystem::path& file) {
   std::ifstream in(file);
@@ -114,9 +70,10 @@ struct RunOptions {
   int frames = -1;  // all
   bool verbose = false;  // one line per frame on stdout
   SystemOptions system;
+  OrbOptions orb;
 };
 
-// Runs the System on a KITTI odometry sequence folder (.../sequences/NN) with the LiDAR stand-in.
+// Runs the System on a KITTI odometry sequence folder (.../sequences/NN) with LiDAR depth.
 inline RunSummary run_kitti_sequence(const std::filesystem::path& sequence, const RunOptions& options) {
   const std::string name = sequence.filename().string();
   const auto image_dir = sequence / ("image_" + std::to_string(options.camera));
@@ -136,8 +93,13 @@ inline RunSummary run_kitti_sequence(const std::filesystem::path& sequence, cons
     double t = 0.0;
     while (in >> t) times.push_back(t);
   }
-  System system(options.system, calibration, std::make_unique<LidarDepthStandIn>(calibration),
-                make_opencv_orb_extractor());
+  DepthSourceSettings depth_settings;
+  depth_settings.calibration = calibration;
+  auto orb = std::make_shared<OrbExtractor>(options.orb);
+  System system(options.system, calibration, make_lidar_source(depth_settings),
+                [orb](const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors) {
+                  orb->extract(gray, keypoints, descriptors);
+                });
   RunSummary summary;
   std::vector<double> depth_ms, extraction_ms, tracking_ms, mapping_ms, front_ms, total_ms;
   std::vector<LidarPoint> scan;

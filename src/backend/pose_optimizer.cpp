@@ -74,9 +74,12 @@ PoseOptimizerResult optimize_pose(const PinholeCamera& camera, const Eigen::Isom
         const double e2 = r.squaredNorm();
         double weight = 1.0;
         if (robust) {
-          const double delta = std::sqrt(dim == 3 ? options.chi2_3d : options.chi2_2d);
-          const double e = std::sqrt(e2);
-          if (e > delta) weight = delta / e;
+          const double delta2 = dim == 3 ? options.chi2_3d : options.chi2_2d;
+          if (options.cauchy) {
+            weight = 1.0 / (1.0 + e2 / delta2);
+          } else if (e2 > delta2) {
+            weight = std::sqrt(delta2 / e2);
+          }
         }
         H.noalias() += weight * J.transpose() * J;
         g.noalias() += weight * J.transpose() * r;

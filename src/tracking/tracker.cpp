@@ -6,6 +6,12 @@
 #include <opencv2/calib3d.hpp>
 
 #include <algorithm>
+#include <random>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <fstream>
+#include <sstream>
 #include <cmath>
 #include <mutex>
 #include <shared_mutex>
@@ -67,7 +73,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   const Eigen::Isometry3d T_predicted = velocity_ ? *velocity_ * T_last : T_last;
   bool ok = false;
   if (state_ == TrackState::Ok) {
-    if (velocity_ && last_frame_) ok = track_with_motion_model(frame);
+    if (velocity_ && last_frame_ && std::getenv("RGBL_NO_MM") == nullptr) ok = track_with_motion_model(frame);
     if (!ok) {
       clear_matches(frame);
       ok = track_reference_keyframe(frame);
@@ -77,7 +83,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     outcome.relocalised = ok;
   }
   int inliers = 0;
-  if (ok) {
+  if (ok && std::getenv("RGBL_NO_LM") == nullptr) {
     ok = track_local_map(frame);
     inliers = static_cast<int>(std::count_if(frame.landmarks.begin(), frame.landmarks.end(),
                                              [](LandmarkId l) { return l.valid(); }));
@@ -129,7 +135,7 @@ bool Tracker::initialise(Frame& frame) {
   return true;
 }
 
-int Tracker::optimise_pose(Frame& frame) {
+int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra) {
   std::vector<PoseObservation> observations;
   std::vector<std::size_t> keypoint_of;
   observations.reserve(frame.size());
@@ -153,6 +159,18 @@ int Tracker::optimise_pose(Frame& frame) {
       keypoint_of.push_back(i);
     }
   }
+  for (const auto& [i, p_world] : extra) {
+    PoseObservation o;
+    o.p_world = p_world;
+    o.pixel = Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y);
+    o.sigma_px = level_scale(map_, frame.keypoints[i].level);
+    if (frame.depth_sigma[i] > 0.0F && frame.depth[i] < options_.close_depth) {
+      o.depth = frame.depth[i];
+      o.depth_sigma = frame.depth_sigma[i];
+    }
+    observations.push_back(o);
+    keypoint_of.push_back(i);
+  }
   if (observations.size() < static_cast<std::size_t>(options_.min_pose_inliers)) return 0;
   const PoseOptimizerResult result = optimize_pose(camera_, frame.T_cam_world, observations, options_.pose);
   frame.T_cam_world = result.T_cam_world;
@@ -160,43 +178,184 @@ int Tracker::optimise_pose(Frame& frame) {
   return result.inliers;
 }
 
+namespace {
+
+// Frame-to-frame motion from depth on both sides, independent of any prediction: brute-force matching
+// (ratio test) between keypoints with depth, then a 3-point RANSAC on the rigid 3-D alignment. Breaks
+// the feedback of the constant-velocity prediction on periodic or weak texture (fences, grass), where
+// guided matching around a slightly wrong prediction finds matches that confirm it.
+std::optional<Eigen::Isometry3d> depth_motion_ransac(const PinholeCamera& camera, const Frame& last, const Frame& frame,
+                                                     const TrackerOptions& options) {
+  std::vector<Descriptor> last_desc, cur_desc;
+  std::vector<Eigen::Vector3d> last_pts, cur_pts;
+  for (std::size_t i = 0; i < last.size(); ++i) {
+    if (last.depth_sigma[i] <= 0.0F) continue;
+    last_desc.push_back(last.descriptors[i]);
+    last_pts.push_back(camera.unproject(Eigen::Vector2d(last.keypoints[i].x, last.keypoints[i].y), last.depth[i]));
+  }
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.depth_sigma[i] <= 0.0F) continue;
+    cur_desc.push_back(frame.descriptors[i]);
+    cur_pts.push_back(camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y), frame.depth[i]));
+  }
+  const auto matches = detail::match_brute_force(cur_desc, last_desc, options.ransac_max_hamming, options.ransac_ratio);
+  const int n = static_cast<int>(matches.size());
+  if (n < options.ransac_min_inliers) return std::nullopt;
+  auto fit = [&](const std::vector<int>& idx) {
+    Eigen::Matrix3Xd a(3, static_cast<Eigen::Index>(idx.size())), b(3, static_cast<Eigen::Index>(idx.size()));
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      const auto& [q, t] = matches[static_cast<std::size_t>(idx[k])];
+      a.col(static_cast<Eigen::Index>(k)) = last_pts[static_cast<std::size_t>(t)];
+      b.col(static_cast<Eigen::Index>(k)) = cur_pts[static_cast<std::size_t>(q)];
+    }
+    Eigen::Isometry3d T;
+    T.matrix() = Eigen::umeyama(a, b, false);
+    return T;
+  };
+  auto inliers_of = [&](const Eigen::Isometry3d& T, std::vector<int>& out) {
+    out.clear();
+    for (int m = 0; m < n; ++m) {
+      const auto& [q, t] = matches[static_cast<std::size_t>(m)];
+      const Eigen::Vector3d& pc = cur_pts[static_cast<std::size_t>(q)];
+      const double tolerance = std::max(options.ransac_min_tolerance, options.ransac_relative_tolerance * pc.z());
+      if ((T * last_pts[static_cast<std::size_t>(t)] - pc).norm() < tolerance) out.push_back(m);
+    }
+  };
+  std::mt19937 rng(7);  // fixed seed: deterministic
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  std::vector<int> best, current;
+  for (int it = 0; it < options.ransac_iterations; ++it) {
+    std::vector<int> sample = {pick(rng), pick(rng), pick(rng)};
+    if (sample[0] == sample[1] || sample[1] == sample[2] || sample[0] == sample[2]) continue;
+    inliers_of(fit(sample), current);
+    if (current.size() > best.size()) best.swap(current);
+  }
+  if (static_cast<int>(best.size()) < options.ransac_min_inliers) return std::nullopt;
+  Eigen::Isometry3d T = fit(best);
+  inliers_of(T, best);
+  if (static_cast<int>(best.size()) < options.ransac_min_inliers) return std::nullopt;
+  return fit(best);
+}
+
+}  // namespace
+
 bool Tracker::track_with_motion_model(Frame& frame) {
   frame.T_cam_world = *velocity_ * last_frame_->T_cam_world;
+  if (options_.ransac_prediction) {
+    if (const auto T_cur_last = depth_motion_ransac(camera_, *last_frame_, frame, options_)) {
+      frame.T_cam_world = *T_cur_last * last_frame_->T_cam_world;
+    }
+  }
   std::vector<detail::ProjectedLandmark> candidates;
+  std::vector<Eigen::Vector3d> candidate_points;
+  const Eigen::Isometry3d T_world_last = last_frame_->T_cam_world.inverse();
   auto build = [&](double radius_factor) {
     candidates.clear();
+    candidate_points.clear();
     std::shared_lock lock(map_.mutex());
     const Frame& last = *last_frame_;
     for (std::size_t i = 0; i < last.size(); ++i) {
-      if (!last.landmarks[i].valid() || last.outlier[i]) continue;
-      const Landmark* l = map_.landmark(last.landmarks[i]);
-      if (l == nullptr) continue;
-      const Eigen::Vector3d p = frame.T_cam_world * l->position;
+      const bool landmark = last.landmarks[i].valid() && !last.outlier[i];
+      const Landmark* l = landmark ? map_.landmark(last.landmarks[i]) : nullptr;
+      // Keypoints of the last frame with depth but no landmark become temporary points (ORB-SLAM's
+      // visual-odometry points): they anchor frame-to-frame motion where the map is thin.
+      const bool temporary = l == nullptr && last.depth_sigma[i] > 0.0F && options_.temporary_points;
+      if (l == nullptr && !temporary) continue;
+      const Eigen::Vector3d p_world =
+          l != nullptr ? l->position
+                       : T_world_last * camera_.unproject(Eigen::Vector2d(last.keypoints[i].x, last.keypoints[i].y),
+                                                          last.depth[i]);
+      const Eigen::Vector3d p = frame.T_cam_world * p_world;
       if (p.z() <= 0.0) continue;
       const Eigen::Vector2d px = camera_.project_unchecked(p);
       if (!camera_.in_image(px)) continue;
       const int level = last.keypoints[i].level;
       detail::ProjectedLandmark c;
-      c.id = l->id;
-      c.descriptor = &l->descriptor;
+      if (l != nullptr) c.id = l->id;
+      c.descriptor = l != nullptr ? &l->descriptor : &last.descriptors[i];
       c.x = static_cast<float>(px.x());
       c.y = static_cast<float>(px.y());
       c.radius = static_cast<float>(radius_factor * level_scale(map_, level));
+      candidate_points.push_back(p_world);
       c.min_level = std::max(0, level - 1);
       c.max_level = level + 1;
       c.angle = last.keypoints[i].angle;
+      c.depth = static_cast<float>(p.z());
       candidates.push_back(c);
     }
   };
+  std::vector<int> candidate_of_keypoint;
+  const detail::DepthGate gate{static_cast<float>(options_.depth_gate_sigmas),
+                               static_cast<float>(options_.depth_gate_min_motion)};
   build(options_.motion_radius);
-  int matches = detail::match_projected(frame, candidates, options_.max_hamming, 1.0, options_.check_orientation);
+  int matches = detail::match_projected(frame, candidates, options_.motion_max_hamming, options_.motion_ratio, options_.check_orientation,
+                                        &candidate_of_keypoint, gate);
   if (matches < options_.motion_min_matches) {
     clear_matches(frame);
     build(2.0 * options_.motion_radius);
-    matches = detail::match_projected(frame, candidates, options_.max_hamming, 1.0, options_.check_orientation);
+    matches = detail::match_projected(frame, candidates, options_.motion_max_hamming, options_.motion_ratio, options_.check_orientation,
+                                      &candidate_of_keypoint, gate);
   }
   if (matches < options_.motion_min_matches) return false;
-  const int inliers = optimise_pose(frame);
+  std::vector<std::pair<std::size_t, Eigen::Vector3d>> extra;
+  for (std::size_t k = 0; k < frame.size(); ++k) {
+    const int c = candidate_of_keypoint[k];
+    if (c >= 0 && !candidates[static_cast<std::size_t>(c)].id.valid()) {
+      extra.emplace_back(k, candidate_points[static_cast<std::size_t>(c)]);
+    }
+  }
+  const Eigen::Isometry3d T_pred = frame.T_cam_world;
+  const int inliers = optimise_pose(frame, extra);
+  if (std::getenv("RGBL_TRACK_DEBUG") != nullptr) {
+    const Eigen::Vector3d d = (frame.T_cam_world * T_pred.inverse()).translation();
+    if (FILE* f = std::fopen(("/tmp/mmdump_" + std::to_string(frame.index) + ".txt").c_str(), "w")) {
+      std::shared_lock lock(map_.mutex());
+      for (std::size_t i = 0; i < frame.size(); ++i) {
+        if (!frame.landmarks[i].valid()) continue;
+        const Landmark* l = map_.landmark(frame.landmarks[i]);
+        if (l == nullptr) continue;
+        const Eigen::Vector2d a = camera_.project_unchecked(T_pred * l->position);
+        const Eigen::Vector2d b = camera_.project_unchecked(frame.T_cam_world * l->position);
+        std::fprintf(f, "%.1f %.1f %.1f %.1f %.1f %.1f %d %.2f %.2f\n", frame.keypoints[i].x, frame.keypoints[i].y, a.x(), a.y(),
+                     b.x(), b.y(), frame.outlier[i] ? 0 : 1, frame.depth[i], (frame.T_cam_world * l->position).z());
+      }
+      for (const auto& [i, pw] : extra) {
+        const Eigen::Vector2d a = camera_.project_unchecked(T_pred * pw);
+        const Eigen::Vector2d b = camera_.project_unchecked(frame.T_cam_world * pw);
+        std::fprintf(f, "%.1f %.1f %.1f %.1f %.1f %.1f %d %.2f %.2f\n", frame.keypoints[i].x, frame.keypoints[i].y, a.x(), a.y(),
+                     b.x(), b.y(), frame.outlier[i] ? 0 : 1, frame.depth[i], (frame.T_cam_world * pw).z());
+      }
+      std::fclose(f);
+    }
+    if (const char* gt_path = std::getenv("RGBL_GT")) {
+      std::ifstream in(gt_path);
+      std::string line;
+      for (std::size_t n = 0; std::getline(in, line); ++n) {
+        if (n != frame.index) continue;
+        std::istringstream ss(line);
+        Matrix34d M;
+        for (int r = 0; r < 3; ++r) for (int c = 0; c < 4; ++c) ss >> M(r, c);
+        const Eigen::Isometry3d T_gt = isometry_from_3x4(M).inverse();
+        std::vector<PoseObservation> obs;
+        std::shared_lock lock(map_.mutex());
+        auto add = [&](std::size_t i, const Eigen::Vector3d& pw) {
+          PoseObservation o; o.p_world = pw; o.pixel = Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y);
+          o.sigma_px = level_scale(map_, frame.keypoints[i].level);
+          if (frame.depth_sigma[i] > 0.0F) { o.depth = frame.depth[i]; o.depth_sigma = frame.depth_sigma[i]; }
+          obs.push_back(o);
+        };
+        for (std::size_t i = 0; i < frame.size(); ++i) if (frame.landmarks[i].valid()) if (const Landmark* l = map_.landmark(frame.landmarks[i])) add(i, l->position);
+        for (const auto& [i, pw] : extra) add(i, pw);
+        auto count = [&](const Eigen::Isometry3d& T) { int c = 0; double e2s = 0; Eigen::Vector3d r; Eigen::Matrix<double,3,6> J; int dim;
+          for (const auto& o : obs) { if (!pose_residual(camera_, T, o, r, J, dim)) continue; const double e2 = r.squaredNorm(); if (e2 < (dim == 3 ? 7.815 : 5.991)) { ++c; e2s += e2; } } return std::make_pair(c, e2s); };
+        const auto a = count(T_gt), b = count(frame.T_cam_world), c = count(T_pred);
+        const auto refined = optimize_pose(camera_, T_gt, obs, options_.pose);
+        std::fprintf(stderr, "  gt: inliers at gt %d (%.0f) est %d (%.0f) pred %d (%.0f); refined from gt: %d, dz from gt %.3f\n", a.first, a.second, b.first, b.second, c.first, c.second,
+                     refined.inliers, (refined.T_cam_world * T_gt.inverse()).translation().z());
+      }
+    }
+    std::fprintf(stderr, "  mm: matches %d inliers %d correction %.3f %.3f %.3f\n", matches, inliers, d.x(), d.y(), d.z());
+  }
   discard_outliers(frame);
   return inliers >= options_.min_pose_inliers;
 }
@@ -303,11 +462,38 @@ bool Tracker::track_local_map(Frame& frame) {
       c.radius = static_cast<float>(options_.local_map_radius * std::pow(scale, level));
       c.min_level = std::max(0, level - 1);
       c.max_level = level;
+      c.depth = static_cast<float>(p.z());
       candidates.push_back(c);
     }
-    detail::match_projected(frame, candidates, options_.max_hamming, options_.local_map_ratio, false);
+    const detail::DepthGate gate{static_cast<float>(options_.depth_gate_sigmas),
+                                 static_cast<float>(options_.depth_gate_min_local_map)};
+    lm_matches_ =
+        detail::match_projected(frame, candidates, options_.max_hamming, options_.local_map_ratio, false, nullptr, gate);
   }
+  const Eigen::Isometry3d T_before = frame.T_cam_world;
   const int inliers = optimise_pose(frame);
+  if (std::getenv("RGBL_TRACK_DEBUG") != nullptr) {
+    const Eigen::Vector3d d = (frame.T_cam_world * T_before.inverse()).translation();
+    int with_depth = 0;
+    double mean_dz = 0.0;
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      if (!frame.landmarks[i].valid() || frame.outlier[i] || frame.depth[i] <= 0.0F) continue;
+      const Landmark* l = map_.landmark(frame.landmarks[i]);
+      if (l == nullptr) continue;
+      ++with_depth;
+      mean_dz += (frame.T_cam_world * l->position).z() - frame.depth[i];
+    }
+    if (FILE* f = std::fopen(("/tmp/trkdump_" + std::to_string(frame.index) + ".txt").c_str(), "w")) {
+      for (std::size_t i = 0; i < frame.size(); ++i) {
+        const int status = !frame.landmarks[i].valid() ? 0 : (frame.outlier[i] ? 1 : 2);
+        std::fprintf(f, "%.1f %.1f %d %.2f\n", frame.keypoints[i].x, frame.keypoints[i].y, status, frame.depth[i]);
+      }
+      std::fclose(f);
+    }
+    std::fprintf(stderr, "  lm: local kf %zu lms %zu cand %zu matched %d inliers %d (depth %d, mean dz %.3f) correction %.3f %.3f %.3f\n",
+                 local_keyframes_.size(), local_landmarks_.size(), candidates.size(), lm_matches_, inliers, with_depth,
+                 with_depth > 0 ? mean_dz / with_depth : 0.0, d.x(), d.y(), d.z());
+  }
   {
     std::unique_lock lock(map_.mutex());
     for (const LandmarkId id : visible) {

@@ -13,6 +13,9 @@ struct DepthNoiseModel {
   // Depth change per pixel moved on a surface seen at grazing angle is ~ z^2 / (f * h); this gain
   // times sample_distance_px * z^2 / fx is the added sigma for a value copied from a neighbour pixel.
   double sigma_per_pixel = 0.4;
+  // Triangulation-like growth sigma = sigma_quadratic * z^2 (ORB-SLAM's virtual baseline bf gives
+  // 1 / bf here), for errors that grow with z^2: LiDAR-camera calibration and sync, motion distortion.
+  double sigma_quadratic = 0.0;
   double max_spread = 1.0;          // m; above max(max_spread, max_spread_relative * z): a depth edge
   double max_spread_relative = 0.05;
   double min_depth = 0.1, max_depth = 120.0;  // m; depths outside are not used

@@ -28,6 +28,10 @@ struct PoseOptimizerOptions {
   double chi2_2d = 5.991;      // 95% of chi2 with 2 dof
   double chi2_3d = 7.815;      // 95% of chi2 with 3 dof
   bool robust_last_round = false;  // ORB-SLAM drops the robust kernel in the last rounds
+  // Huber's influence never vanishes: a few points with a small depth sigma that move with the camera
+  // (a car ahead) pull the first round off. With cauchy the influence of residuals far beyond the
+  // threshold fades (weight 1 / (1 + e^2 / c^2)).
+  bool cauchy = false;
   double min_depth = 1e-3;     // points closer than this to the camera plane are outliers
 
   void validate() const;

@@ -13,6 +13,8 @@ struct TrackerOptions {
   int min_initial_depth_points = 300;   // keypoints with usable depth to initialise
   double motion_radius = 15.0;          // px at level 0, guided matching with the motion model
   int motion_min_matches = 20;          // retry with 2x radius below this
+  int motion_max_hamming = 100;
+  double motion_ratio = 1.0;            // best/second-best test on the same level (1 = off, as ORB-SLAM)
   double local_map_radius = 3.0;        // px at level 0, local-map search
   int max_hamming = 100;
   int max_hamming_strict = 50;
@@ -24,6 +26,19 @@ struct TrackerOptions {
   int min_local_map_inliers = 30;       // local-map tracking success
   int relocalisation_min_inliers = 50;
   bool check_orientation = true;        // rotation histogram consistency in guided matching
+  // Depth gate in guided matching (0 sigmas = off): |measured - predicted z| <= max(min, sigmas * sigma).
+  double depth_gate_sigmas = 3.0;
+  double depth_gate_min_motion = 1.0;     // m, around the constant-velocity prediction
+  double depth_gate_min_local_map = 0.3;  // m, around the motion-model pose
+  // Prediction from depth-to-depth RANSAC between consecutive frames instead of constant velocity
+  bool ransac_prediction = true;
+  int ransac_max_hamming = 64;
+  double ransac_ratio = 0.7;
+  int ransac_iterations = 100;
+  int ransac_min_inliers = 30;
+  double ransac_min_tolerance = 0.2;       // m
+  double ransac_relative_tolerance = 0.03; // of z
+  bool temporary_points = true;         // last-frame depth points without landmark join the motion model
   // Keyframe decision (SPEC section 5)
   int max_frames_between_keyframes = 10;
   double reference_ratio_threshold = 0.75;

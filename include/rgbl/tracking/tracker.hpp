@@ -38,6 +38,8 @@ class Tracker {
 
   TrackState state() const { return state_; }
   KeyframeId reference_keyframe() const { return reference_; }
+  // Constant-velocity motion T_cur_last of the last tracked frame pair, if any.
+  const std::optional<Eigen::Isometry3d>& velocity() const { return velocity_; }
 
  private:
   bool initialise(Frame& frame);
@@ -45,7 +47,8 @@ class Tracker {
   bool track_reference_keyframe(Frame& frame);
   bool track_local_map(Frame& frame);
   bool relocalise(Frame& frame);
-  int optimise_pose(Frame& frame);
+  // extra: (keypoint, world point) correspondences that are not landmarks (temporary points).
+  int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {});
   bool need_keyframe(const Frame& frame, int inliers, bool mapping_idle) const;
   void update_local_map(const Frame& frame);
 
@@ -60,6 +63,7 @@ class Tracker {
   std::optional<Eigen::Isometry3d> velocity_;  // T_cur_last
   std::vector<KeyframeId> local_keyframes_;
   std::vector<LandmarkId> local_landmarks_;
+  int lm_matches_ = 0;
 };
 
 }  // namespace rgbl
