@@ -8,7 +8,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
-#include <cstdlib>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -170,15 +169,6 @@ TrackResult System::track(const SensorFrame& sensor) {
   }
   if (s.options.lidar_scan_period > 0.0 && s.tracker.state() == TrackState::Ok && s.tracker.velocity()) {
     compensate_lidar_motion(s, frame);
-  }
-  if (std::getenv("RGBL_MASK_VAN") != nullptr) {
-    std::vector<Keypoint> k2; std::vector<Descriptor> d2; std::vector<float> z2, s2;
-    for (std::size_t i = 0; i < frame.size(); ++i) {
-      const auto& kp = frame.keypoints[i];
-      if (kp.x > 550 && kp.x < 660 && kp.y > 140 && kp.y < 250) continue;
-      k2.push_back(kp); d2.push_back(frame.descriptors[i]); z2.push_back(frame.depth[i]); s2.push_back(frame.depth_sigma[i]);
-    }
-    frame.keypoints = k2; frame.descriptors = d2; frame.depth = z2; frame.depth_sigma = s2;
   }
   frame.build_grid(s.calibration.camera.width, s.calibration.camera.height);
   result.timing.depth_ms += stage.lap_ms();

@@ -7,11 +7,6 @@
 
 #include <algorithm>
 #include <random>
-#include <cstdio>
-#include <cstdlib>
-#include <string>
-#include <fstream>
-#include <sstream>
 #include <cmath>
 #include <mutex>
 #include <shared_mutex>
@@ -73,7 +68,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   const Eigen::Isometry3d T_predicted = velocity_ ? *velocity_ * T_last : T_last;
   bool ok = false;
   if (state_ == TrackState::Ok) {
-    if (velocity_ && last_frame_ && std::getenv("RGBL_NO_MM") == nullptr) ok = track_with_motion_model(frame);
+    if (velocity_ && last_frame_) ok = track_with_motion_model(frame);
     if (!ok) {
       clear_matches(frame);
       ok = track_reference_keyframe(frame);
@@ -83,7 +78,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     outcome.relocalised = ok;
   }
   int inliers = 0;
-  if (ok && std::getenv("RGBL_NO_LM") == nullptr) {
+  if (ok) {
     ok = track_local_map(frame);
     inliers = static_cast<int>(std::count_if(frame.landmarks.begin(), frame.landmarks.end(),
                                              [](LandmarkId l) { return l.valid(); }));
@@ -304,58 +299,7 @@ bool Tracker::track_with_motion_model(Frame& frame) {
       extra.emplace_back(k, candidate_points[static_cast<std::size_t>(c)]);
     }
   }
-  const Eigen::Isometry3d T_pred = frame.T_cam_world;
   const int inliers = optimise_pose(frame, extra);
-  if (std::getenv("RGBL_TRACK_DEBUG") != nullptr) {
-    const Eigen::Vector3d d = (frame.T_cam_world * T_pred.inverse()).translation();
-    if (FILE* f = std::fopen(("/tmp/mmdump_" + std::to_string(frame.index) + ".txt").c_str(), "w")) {
-      std::shared_lock lock(map_.mutex());
-      for (std::size_t i = 0; i < frame.size(); ++i) {
-        if (!frame.landmarks[i].valid()) continue;
-        const Landmark* l = map_.landmark(frame.landmarks[i]);
-        if (l == nullptr) continue;
-        const Eigen::Vector2d a = camera_.project_unchecked(T_pred * l->position);
-        const Eigen::Vector2d b = camera_.project_unchecked(frame.T_cam_world * l->position);
-        std::fprintf(f, "%.1f %.1f %.1f %.1f %.1f %.1f %d %.2f %.2f\n", frame.keypoints[i].x, frame.keypoints[i].y, a.x(), a.y(),
-                     b.x(), b.y(), frame.outlier[i] ? 0 : 1, frame.depth[i], (frame.T_cam_world * l->position).z());
-      }
-      for (const auto& [i, pw] : extra) {
-        const Eigen::Vector2d a = camera_.project_unchecked(T_pred * pw);
-        const Eigen::Vector2d b = camera_.project_unchecked(frame.T_cam_world * pw);
-        std::fprintf(f, "%.1f %.1f %.1f %.1f %.1f %.1f %d %.2f %.2f\n", frame.keypoints[i].x, frame.keypoints[i].y, a.x(), a.y(),
-                     b.x(), b.y(), frame.outlier[i] ? 0 : 1, frame.depth[i], (frame.T_cam_world * pw).z());
-      }
-      std::fclose(f);
-    }
-    if (const char* gt_path = std::getenv("RGBL_GT")) {
-      std::ifstream in(gt_path);
-      std::string line;
-      for (std::size_t n = 0; std::getline(in, line); ++n) {
-        if (n != frame.index) continue;
-        std::istringstream ss(line);
-        Matrix34d M;
-        for (int r = 0; r < 3; ++r) for (int c = 0; c < 4; ++c) ss >> M(r, c);
-        const Eigen::Isometry3d T_gt = isometry_from_3x4(M).inverse();
-        std::vector<PoseObservation> obs;
-        std::shared_lock lock(map_.mutex());
-        auto add = [&](std::size_t i, const Eigen::Vector3d& pw) {
-          PoseObservation o; o.p_world = pw; o.pixel = Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y);
-          o.sigma_px = level_scale(map_, frame.keypoints[i].level);
-          if (frame.depth_sigma[i] > 0.0F) { o.depth = frame.depth[i]; o.depth_sigma = frame.depth_sigma[i]; }
-          obs.push_back(o);
-        };
-        for (std::size_t i = 0; i < frame.size(); ++i) if (frame.landmarks[i].valid()) if (const Landmark* l = map_.landmark(frame.landmarks[i])) add(i, l->position);
-        for (const auto& [i, pw] : extra) add(i, pw);
-        auto count = [&](const Eigen::Isometry3d& T) { int c = 0; double e2s = 0; Eigen::Vector3d r; Eigen::Matrix<double,3,6> J; int dim;
-          for (const auto& o : obs) { if (!pose_residual(camera_, T, o, r, J, dim)) continue; const double e2 = r.squaredNorm(); if (e2 < (dim == 3 ? 7.815 : 5.991)) { ++c; e2s += e2; } } return std::make_pair(c, e2s); };
-        const auto a = count(T_gt), b = count(frame.T_cam_world), c = count(T_pred);
-        const auto refined = optimize_pose(camera_, T_gt, obs, options_.pose);
-        std::fprintf(stderr, "  gt: inliers at gt %d (%.0f) est %d (%.0f) pred %d (%.0f); refined from gt: %d, dz from gt %.3f\n", a.first, a.second, b.first, b.second, c.first, c.second,
-                     refined.inliers, (refined.T_cam_world * T_gt.inverse()).translation().z());
-      }
-    }
-    std::fprintf(stderr, "  mm: matches %d inliers %d correction %.3f %.3f %.3f\n", matches, inliers, d.x(), d.y(), d.z());
-  }
   discard_outliers(frame);
   return inliers >= options_.min_pose_inliers;
 }
@@ -467,33 +411,9 @@ bool Tracker::track_local_map(Frame& frame) {
     }
     const detail::DepthGate gate{static_cast<float>(options_.depth_gate_sigmas),
                                  static_cast<float>(options_.depth_gate_min_local_map)};
-    lm_matches_ =
-        detail::match_projected(frame, candidates, options_.max_hamming, options_.local_map_ratio, false, nullptr, gate);
+    detail::match_projected(frame, candidates, options_.max_hamming, options_.local_map_ratio, false, nullptr, gate);
   }
-  const Eigen::Isometry3d T_before = frame.T_cam_world;
   const int inliers = optimise_pose(frame);
-  if (std::getenv("RGBL_TRACK_DEBUG") != nullptr) {
-    const Eigen::Vector3d d = (frame.T_cam_world * T_before.inverse()).translation();
-    int with_depth = 0;
-    double mean_dz = 0.0;
-    for (std::size_t i = 0; i < frame.size(); ++i) {
-      if (!frame.landmarks[i].valid() || frame.outlier[i] || frame.depth[i] <= 0.0F) continue;
-      const Landmark* l = map_.landmark(frame.landmarks[i]);
-      if (l == nullptr) continue;
-      ++with_depth;
-      mean_dz += (frame.T_cam_world * l->position).z() - frame.depth[i];
-    }
-    if (FILE* f = std::fopen(("/tmp/trkdump_" + std::to_string(frame.index) + ".txt").c_str(), "w")) {
-      for (std::size_t i = 0; i < frame.size(); ++i) {
-        const int status = !frame.landmarks[i].valid() ? 0 : (frame.outlier[i] ? 1 : 2);
-        std::fprintf(f, "%.1f %.1f %d %.2f\n", frame.keypoints[i].x, frame.keypoints[i].y, status, frame.depth[i]);
-      }
-      std::fclose(f);
-    }
-    std::fprintf(stderr, "  lm: local kf %zu lms %zu cand %zu matched %d inliers %d (depth %d, mean dz %.3f) correction %.3f %.3f %.3f\n",
-                 local_keyframes_.size(), local_landmarks_.size(), candidates.size(), lm_matches_, inliers, with_depth,
-                 with_depth > 0 ? mean_dz / with_depth : 0.0, d.x(), d.y(), d.z());
-  }
   {
     std::unique_lock lock(map_.mutex());
     for (const LandmarkId id : visible) {

@@ -12,7 +12,7 @@ struct DepthNoiseModel {
   double sigma_relative = 0.005;    // sigma grows by this fraction of z (calibration, sync)
   // Depth change per pixel moved on a surface seen at grazing angle is ~ z^2 / (f * h); this gain
   // times sample_distance_px * z^2 / fx is the added sigma for a value copied from a neighbour pixel.
-  double sigma_per_pixel = 0.4;
+  double sigma_per_pixel = 0.1;
   // Triangulation-like growth sigma = sigma_quadratic * z^2 (ORB-SLAM's virtual baseline bf gives
   // 1 / bf here), for errors that grow with z^2: LiDAR-camera calibration and sync, motion distortion.
   double sigma_quadratic = 0.0;

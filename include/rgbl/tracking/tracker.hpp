@@ -63,7 +63,6 @@ class Tracker {
   std::optional<Eigen::Isometry3d> velocity_;  // T_cur_last
   std::vector<KeyframeId> local_keyframes_;
   std::vector<LandmarkId> local_landmarks_;
-  int lm_matches_ = 0;
 };
 
 }  // namespace rgbl
