@@ -74,8 +74,16 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
       ok = track_reference_keyframe(frame);
     }
   } else {
-    ok = relocalise(frame);
-    outcome.relocalised = ok;
+    // Recently lost: the frame-to-frame motion (depth RANSAC + temporary points) usually still holds
+    // and keeps the trajectory continuous; otherwise relocalise against the whole map.
+    if (velocity_ && last_frame_ && frame.index <= last_ok_frame_ + options_.recent_loss_frames) {
+      ok = track_with_motion_model(frame);
+      if (!ok) clear_matches(frame);
+    }
+    if (!ok) {
+      ok = relocalise(frame);
+      outcome.relocalised = ok;
+    }
   }
   int inliers = 0;
   if (ok) {
@@ -85,6 +93,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   }
   if (ok) {
     state_ = TrackState::Ok;
+    last_ok_frame_ = frame.index;
     if (last_frame_) velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
     outcome.need_keyframe = need_keyframe(frame, inliers, mapping_idle);
   } else {

@@ -59,6 +59,7 @@ class Tracker {
   KeyframeId reference_;
   std::size_t last_keyframe_frame_ = 0;
   std::size_t last_relocalisation_frame_ = 0;
+  std::size_t last_ok_frame_ = 0;
   std::optional<Frame> last_frame_;
   std::optional<Eigen::Isometry3d> velocity_;  // T_cur_last
   std::vector<KeyframeId> local_keyframes_;
