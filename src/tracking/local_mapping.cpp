@@ -1,5 +1,7 @@
 #include "rgbl/tracking/local_mapping.hpp"
 
+#include "matching.hpp"
+
 #include "rgbl/backend/bundle_adjustment.hpp"
 #include "rgbl/core/timer.hpp"
 #include "rgbl/tracking/frame.hpp"
@@ -125,7 +127,7 @@ int LocalMapper::fuse_into(KeyframeId target_id, const std::vector<LandmarkId>& 
         threshold = 7.815;
       }
       if (chi2 > threshold) continue;
-      const int d = hamming_distance(l->descriptor, target->descriptors[ks]);
+      const int d = detail::descriptor_distance(l->descriptor, target->descriptors[ks]);
       if (d < best) {
         best = d;
         best_index = k;

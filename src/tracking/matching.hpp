@@ -11,6 +11,9 @@
 
 namespace rgbl::detail {
 
+// Hamming distance, same value as rgbl::hamming_distance, fast without -mpopcnt.
+int descriptor_distance(const Descriptor& a, const Descriptor& b) noexcept;
+
 struct ProjectedLandmark {
   LandmarkId id;
   const Descriptor* descriptor = nullptr;
