@@ -197,8 +197,15 @@ std::optional<Eigen::Isometry3d> depth_motion_ransac(const PinholeCamera& camera
     last_desc.push_back(last.descriptors[i]);
     last_pts.push_back(camera.unproject(Eigen::Vector2d(last.keypoints[i].x, last.keypoints[i].y), last.depth[i]));
   }
+  // A strided subset of the current keypoints is enough for a 6-DoF consensus and bounds the cost.
+  std::size_t with_depth = 0;
+  for (std::size_t i = 0; i < frame.size(); ++i) with_depth += frame.depth_sigma[i] > 0.0F ? 1 : 0;
+  const std::size_t stride = std::max<std::size_t>(1, (with_depth + options.ransac_max_points - 1) /
+                                                          std::max<std::size_t>(1, options.ransac_max_points));
+  std::size_t seen = 0;
   for (std::size_t i = 0; i < frame.size(); ++i) {
     if (frame.depth_sigma[i] <= 0.0F) continue;
+    if (seen++ % stride != 0) continue;
     cur_desc.push_back(frame.descriptors[i]);
     cur_pts.push_back(camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y), frame.depth[i]));
   }

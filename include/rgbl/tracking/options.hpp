@@ -36,6 +36,7 @@ struct TrackerOptions {
   int ransac_max_hamming = 64;
   double ransac_ratio = 0.7;
   int ransac_iterations = 100;
+  std::size_t ransac_max_points = 350;     // current keypoints with depth used (strided subset)
   int ransac_min_inliers = 30;
   double ransac_min_tolerance = 0.2;       // m
   double ransac_relative_tolerance = 0.03; // of z
