@@ -7,8 +7,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace rgbl {
 
@@ -20,6 +25,7 @@ void OrbOptions::validate() const {
   require(fast_min_threshold >= 1 && fast_min_threshold <= fast_threshold, "orb.fast_min_threshold",
           "in [1, fast_threshold]");
   require(cell_size >= 8, "orb.cell_size", ">= 8");
+  require(features_per_node >= 1, "orb.features_per_node", ">= 1");
   require(patch_size >= 5 && patch_size % 2 == 1, "orb.patch_size", "odd and >= 5");
   require(orientation_radius >= 1, "orb.orientation_radius", ">= 1");
   require(edge_threshold >= std::max(patch_size / 2, orientation_radius) + 1 && edge_threshold >= 4,
@@ -50,9 +56,59 @@ class SplitMix64 {
 
 inline int round_to_int(float v) { return static_cast<int>(v + (v >= 0.0F ? 0.5F : -0.5F)); }
 
+#if defined(__SSE2__)
+inline __m128i load16(const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
+
+inline int horizontal_sum(__m128i v) {
+  v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0x4E));
+  v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0xB1));
+  return _mm_cvtsi128_si32(v);
+}
+
+// Intensity-centroid moments over the disc of radius <= 15: each row pair (+v, -v) as 32 bytes
+// (u = -16..15) masked to the disc, widened to 16 bits; m10 by multiply-add with u, m01 with v.
+// `masks` holds 32 bytes per row offset v (0xFF where |u| <= half width). Needs 16 px left and 15 px
+// right of the centre inside the image.
+inline void centroid_moments_sse2(const std::uint8_t* centre, int step, int radius, const std::uint8_t* masks,
+                                  int& m10, int& m01) {
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i u0 = _mm_setr_epi16(-16, -15, -14, -13, -12, -11, -10, -9);
+  const __m128i u1 = _mm_setr_epi16(-8, -7, -6, -5, -4, -3, -2, -1);
+  const __m128i u2 = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m128i u3 = _mm_setr_epi16(8, 9, 10, 11, 12, 13, 14, 15);
+  __m128i acc10 = zero, acc01 = zero;
+  for (int v = 0; v <= radius; ++v) {
+    const __m128i mask_lo = load16(masks + 32 * v), mask_hi = load16(masks + 32 * v + 16);
+    const std::uint8_t* below = centre + v * step;
+    const __m128i b_lo = _mm_and_si128(load16(below - 16), mask_lo), b_hi = _mm_and_si128(load16(below), mask_hi);
+    __m128i a_lo = zero, a_hi = zero;
+    if (v > 0) {
+      const std::uint8_t* above = centre - v * step;
+      a_lo = _mm_and_si128(load16(above - 16), mask_lo);
+      a_hi = _mm_and_si128(load16(above), mask_hi);
+    }
+    const __m128i b0 = _mm_unpacklo_epi8(b_lo, zero), b1 = _mm_unpackhi_epi8(b_lo, zero);
+    const __m128i b2 = _mm_unpacklo_epi8(b_hi, zero), b3 = _mm_unpackhi_epi8(b_hi, zero);
+    const __m128i a0 = _mm_unpacklo_epi8(a_lo, zero), a1 = _mm_unpackhi_epi8(a_lo, zero);
+    const __m128i a2 = _mm_unpacklo_epi8(a_hi, zero), a3 = _mm_unpackhi_epi8(a_hi, zero);
+    acc10 = _mm_add_epi32(acc10, _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_add_epi16(b0, a0), u0),
+                                                             _mm_madd_epi16(_mm_add_epi16(b1, a1), u1)),
+                                               _mm_add_epi32(_mm_madd_epi16(_mm_add_epi16(b2, a2), u2),
+                                                             _mm_madd_epi16(_mm_add_epi16(b3, a3), u3))));
+    if (v > 0) {
+      const __m128i diff = _mm_add_epi16(_mm_add_epi16(_mm_sub_epi16(b0, a0), _mm_sub_epi16(b1, a1)),
+                                         _mm_add_epi16(_mm_sub_epi16(b2, a2), _mm_sub_epi16(b3, a3)));
+      acc01 = _mm_add_epi32(acc01, _mm_madd_epi16(diff, _mm_set1_epi16(static_cast<short>(v))));
+    }
+  }
+  m10 = horizontal_sum(acc10);
+  m01 = horizontal_sum(acc01);
+}
+#endif
+
 }  // namespace
 
-std::vector<BriefPair> make_brief_pattern(int patch_size) {
+std::vector<BriefPair> make_brief_candidates(int patch_size, int count) {
   const double radius = patch_size / 2;  // integer half size: rotated, rounded points stay inside
   const double sigma = patch_size / 5.0;
   SplitMix64 rng(0x5247424C4F524231ULL);  // "RGBLORB1"
@@ -66,14 +122,27 @@ std::vector<BriefPair> make_brief_pattern(int patch_size) {
     }
   };
   std::vector<BriefPair> pattern;
-  pattern.reserve(256);
-  while (pattern.size() < 256) {
+  pattern.reserve(static_cast<std::size_t>(count));
+  while (static_cast<int>(pattern.size()) < count) {
     const auto [x1, y1] = gaussian_point();
     const auto [x2, y2] = gaussian_point();
     // A test between (nearly) the same pixel carries no information.
     if ((x1 - x2) * (x1 - x2) + (y1 - y2) * (y1 - y2) < 4.0F) continue;
     pattern.push_back({x1, y1, x2, y2});
   }
+  return pattern;
+}
+
+namespace {
+#include "brief_pattern_indices.inc"
+}  // namespace
+
+std::vector<BriefPair> make_brief_pattern(int patch_size) {
+  if (patch_size != 31 || kLearnedPairs.empty()) return make_brief_candidates(patch_size, 256);
+  const auto pool = make_brief_candidates(31, kLearnedPoolSize);
+  std::vector<BriefPair> pattern;
+  pattern.reserve(kLearnedPairs.size());
+  for (const auto index : kLearnedPairs) pattern.push_back(pool[index]);
   return pattern;
 }
 
@@ -104,6 +173,17 @@ OrbExtractor::OrbExtractor(const OrbOptions& options) : options_(options) {
   for (int v = 0; v <= r; ++v) {
     disc_half_width_[static_cast<std::size_t>(v)] =
         static_cast<int>(std::floor(std::sqrt(static_cast<double>(r * r - v * v)) + 0.5));
+  }
+  // Row masks for the SIMD centroid: 32 bytes per row, u = -16..15 (needs r <= 15 and 16 px of border).
+  if (r <= 15 && options_.edge_threshold >= 16) {
+    disc_masks_.assign(static_cast<std::size_t>(r + 1) * 32, 0);
+    for (int v = 0; v <= r; ++v) {
+      for (int u = -16; u < 16; ++u) {
+        if (std::abs(u) <= disc_half_width_[static_cast<std::size_t>(v)]) {
+          disc_masks_[static_cast<std::size_t>(v * 32 + u + 16)] = 0xFF;
+        }
+      }
+    }
   }
   pyramid_.resize(static_cast<std::size_t>(levels));
 }
@@ -155,9 +235,10 @@ void OrbExtractor::detect_level(int level) {
   }
 }
 
-// Quadtree over the candidates: split nodes (breadth first) until there are `target` nodes or every
-// node holds one corner; when a full round would overshoot, split the most populated nodes first. Each
-// node then contributes its strongest corner.
+// Quadtree over the candidates: split nodes (breadth first) until there are target / per_node nodes or
+// every node holds one corner; when a full round would overshoot, split the most populated nodes
+// first. Each node then contributes its per_node strongest corners (ties: by position), and if that
+// is more than `target` the strongest of them are kept.
 void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
   selected.clear();
   if (candidates_.empty() || target <= 0) return;
@@ -166,6 +247,9 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
     selected.assign(candidates_.begin(), candidates_.end());
     return;
   }
+  // The quadtree aims at target / per_node nodes, each contributing its per_node strongest corners.
+  const int per_node = options_.features_per_node;
+  const int target_nodes = (target + per_node - 1) / per_node;
   float min_x = candidates_[0].x, max_x = min_x, min_y = candidates_[0].y, max_y = min_y;
   for (const auto& c : candidates_) {
     min_x = std::min(min_x, c.x);
@@ -222,10 +306,10 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
     }
   };
   for (;;) {
-    if (static_cast<int>(nodes_.size()) >= target) break;
+    if (static_cast<int>(nodes_.size()) >= target_nodes) break;
     const auto expandable = static_cast<int>(std::count_if(nodes_.begin(), nodes_.end(), splittable));
     if (expandable == 0) break;
-    if (static_cast<int>(nodes_.size()) + 3 * expandable < target) {
+    if (static_cast<int>(nodes_.size()) + 3 * expandable < target_nodes) {
       next_nodes_.clear();
       for (const Node& node : nodes_) {
         if (splittable(node)) {
@@ -244,7 +328,7 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
     std::size_t i = 0;
     for (; i < nodes_.size(); ++i) {
       const std::size_t total = next_nodes_.size() + (nodes_.size() - i);
-      if (static_cast<int>(total) >= target) break;
+      if (static_cast<int>(total) >= target_nodes) break;
       if (splittable(nodes_[i])) {
         split(nodes_[i], next_nodes_);
       } else {
@@ -254,18 +338,17 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
     for (; i < nodes_.size(); ++i) next_nodes_.push_back(nodes_[i]);
     nodes_.swap(next_nodes_);
   }
-  selected.reserve(nodes_.size());
+  const auto stronger = [](const Candidate& a, const Candidate& b) {
+    if (a.response != b.response) return a.response > b.response;
+    return a.y < b.y || (a.y == b.y && a.x < b.x);  // ties by position: independent of partition order
+  };
+  selected.reserve(nodes_.size() * static_cast<std::size_t>(per_node));
   for (const Node& node : nodes_) {
-    const Candidate* best = &candidates_[static_cast<std::size_t>(node.begin)];
-    for (int j = node.begin + 1; j < node.end; ++j) {
-      const Candidate& c = candidates_[static_cast<std::size_t>(j)];
-      // Ties broken by position so that the result does not depend on partition order.
-      if (c.response > best->response ||
-          (c.response == best->response && (c.y < best->y || (c.y == best->y && c.x < best->x)))) {
-        best = &c;
-      }
-    }
-    selected.push_back(*best);
+    auto* first = candidates_.data() + node.begin;
+    auto* last = candidates_.data() + node.end;
+    const int keep = std::min(per_node, node.end - node.begin);
+    std::partial_sort(first, first + keep, last, stronger);
+    selected.insert(selected.end(), first, first + keep);
   }
   if (static_cast<int>(selected.size()) > target) {
     std::stable_sort(selected.begin(), selected.end(),
@@ -292,6 +375,12 @@ void OrbExtractor::describe_level(int level, std::span<const Candidate> selected
     // Intensity centroid over the disc: rows +v and -v together.
     const std::uint8_t* centre = img.ptr<std::uint8_t>(cy) + cx;
     int m10 = 0, m01 = 0;
+#if defined(__SSE2__)
+    if (!disc_masks_.empty()) {
+      centroid_moments_sse2(centre, step, r, disc_masks_.data(), m10, m01);
+    } else
+#endif
+    {
     for (int u = -r; u <= r; ++u) m10 += u * centre[u];
     for (int v = 1; v <= r; ++v) {
       const int w = disc_half_width_[static_cast<std::size_t>(v)];
@@ -305,6 +394,7 @@ void OrbExtractor::describe_level(int level, std::span<const Candidate> selected
       }
       m01 += v * sum_diff;
       m10 += sum_x;
+    }
     }
     float angle = std::atan2(static_cast<float>(m01), static_cast<float>(m10)) * kRadToDeg;
     if (angle < 0.0F) angle += 360.0F;

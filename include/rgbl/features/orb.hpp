@@ -30,6 +30,10 @@ struct OrbOptions {
   int fast_threshold = 12;      // per-cell threshold...
   int fast_min_threshold = 7;   // ...and the fallback for cells with no corner at fast_threshold
   int cell_size = 35;           // px at each level, for the threshold fallback
+  // The quadtree splits until it has num_features / features_per_node nodes per level budget and
+  // keeps the features_per_node strongest corners of each: 1 is ORB-SLAM's distribution; larger
+  // values trade spread for strength (see docs/features.md).
+  int features_per_node = 1;
   int edge_threshold = 19;      // keypoints keep this many px from every level border
   int patch_size = 31;          // BRIEF patch diameter; sampling points lie within patch_size / 2
   int orientation_radius = 15;  // intensity-centroid disc radius
@@ -43,16 +47,28 @@ struct BriefPair {
   float x1, y1, x2, y2;
 };
 
-// The 256 sampling pairs: drawn from a fixed-seed generator (SplitMix64 + Box-Muller), isotropic
-// Gaussian with sigma = patch_size / 5, clipped to the disc of radius patch_size / 2. The same
-// patch_size always gives the same pattern on every platform.
+// `count` candidate sampling pairs from a fixed-seed generator (SplitMix64 + Box-Muller): isotropic
+// Gaussian with sigma = patch_size / 5, clipped to the disc of radius patch_size / 2, points of a
+// pair >= 2 px apart. The same arguments give the same pairs on every platform; a longer pool starts
+// with the shorter one.
+std::vector<BriefPair> make_brief_candidates(int patch_size, int count);
+
+// The 256 pairs the extractor uses. For patch_size 31: 256 of the first 4096 candidates, chosen
+// offline by apps/learn_brief_pattern (tests with a mean near 0.5 and low mutual correlation on
+// real patches, the ORB paper's criterion); for other sizes the first 256 candidates.
 std::vector<BriefPair> make_brief_pattern(int patch_size);
 
 // Owns the pyramid and scratch buffers, so reusing one extractor across frames allocates nothing in
-// steady state. Not thread-safe: one extractor per thread.
+// steady state. Not thread-safe: one extractor per thread. Move-only, because copies of its cv::Mat
+// scratch would share pixel buffers (and race when used from two threads).
 class OrbExtractor {
  public:
   explicit OrbExtractor(const OrbOptions& options = {});
+  OrbExtractor(const OrbExtractor&) = delete;
+  OrbExtractor& operator=(const OrbExtractor&) = delete;
+  OrbExtractor(OrbExtractor&&) noexcept = default;
+  OrbExtractor& operator=(OrbExtractor&&) noexcept = default;
+  ~OrbExtractor() = default;
 
   // `gray`: CV_8UC1. Clears and fills `keypoints` (level-0 pixel coordinates) and `descriptors` (same
   // length and order). Ordered by level, then by position within the level's quadtree. Deterministic.
@@ -86,6 +102,7 @@ class OrbExtractor {
   std::vector<int> budgets_;
   std::vector<BriefPair> pattern_;
   std::vector<int> disc_half_width_;  // per row offset 0..radius: half width of the orientation disc
+  std::vector<std::uint8_t> disc_masks_;  // the same disc as 32-byte row masks for the SIMD path
   // Scratch reused across calls.
   std::vector<cv::Mat> pyramid_;
   cv::Mat blurred_;
