@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include <cstring>
+#include <limits>
 #include <random>
 
 namespace {
@@ -114,6 +115,10 @@ TEST_CASE("depths the inversion cannot hold count as empty, like the reference")
   sparse(2, 2) = 250.0F;   // beyond M
   sparse(5, 5) = -3.0F;    // negative
   sparse(6, 1) = 199.99999F;
+  sparse(1, 6) = 1e-30F;   // so small that M - d rounds to M: empty for the reference
+  sparse(1, 5) = 30.0F;    // ... so this one must win around it
+  sparse(7, 7) = 200.0F;   // exactly M
+  sparse(0, 7) = std::numeric_limits<float>::infinity();
   for (const auto& o : all_kernels()) CHECK(bit_identical(rgbl::dilate_depth(sparse, o), reference(sparse, o)));
 }
 

@@ -130,3 +130,119 @@ TEST_CASE("lidar source on real frames: keypoint samples equal the dense map") {
   CHECK(mismatches == 0);
   CHECK(with_depth > pixels.size() / 5);
 }
+
+TEST_CASE("precomputed source: reads PNGs, drops the top fraction and far depths, names missing files") {
+  rgbl::test::TempDir dir;
+  auto settings = simple_settings();
+  settings.precomputed.folder = dir.path();
+  settings.precomputed.ignore_top_fraction = 0.25;  // 12 of 48 rows
+  settings.precomputed.max_depth = 50.0F;
+  cv::Mat_<float> depth(48, 64, 10.5F);
+  depth(30, 10) = 60.0F;  // beyond the cap
+  depth(30, 11) = 0.0F;
+  rgbl::write_depth_png(dir.path() / "000007.png", depth);
+  auto source = rgbl::DepthSourceRegistry::with_builtins().create("precomputed", settings);
+  rgbl::SensorFrame frame;
+  frame.index = 7;
+  source->prepare(frame);
+  const cv::Mat_<float> dense = source->dense_depth();
+  CHECK(dense(11, 5) == 0.0F);
+  CHECK(dense(12, 5) == 10.5F);  // 10.5 * 256 is exact in uint16
+  CHECK(dense(30, 10) == 0.0F);
+  CHECK(cv::countNonZero(dense) == 36 * 64 - 2);
+  const std::vector<Eigen::Vector2f> pixels = {{5.2F, 20.0F}, {5.0F, 3.0F}};
+  std::vector<rgbl::KeypointDepth> out(2);
+  source->sample(pixels, out);
+  CHECK(out[0].z == 10.5F);
+  CHECK(out[0].sample_distance_px == Approx(0.2F));
+  CHECK(out[0].spread == 0.0F);
+  CHECK(out[1].z == 0.0F);
+
+  frame.index = 8;
+  CHECK_THROWS_WITH(source->prepare(frame), Contains("000008.png"));
+  rgbl::write_depth_png(dir.path() / "000009.png", cv::Mat_<float>(10, 10, 1.0F));
+  frame.index = 9;
+  CHECK_THROWS_WITH(source->prepare(frame), Contains("000009.png") && Contains("64x48"));
+  settings.precomputed.ignore_top_fraction = 1.0;
+  CHECK_THROWS_WITH(rgbl::DepthSourceRegistry::with_builtins().create("precomputed", settings),
+                    Contains("precomputed.ignore_top_fraction"));
+  settings.precomputed.folder.clear();
+  settings.precomputed.ignore_top_fraction = 0.0;
+  CHECK_THROWS_WITH(rgbl::DepthSourceRegistry::with_builtins().create("precomputed", settings),
+                    Contains("precomputed.folder"));
+}
+
+TEST_CASE("rgbd source: scaled uint16 or float metres, bad input named") {
+  auto settings = simple_settings();
+  settings.rgbd.scale = 5000.0;
+  auto source = rgbl::DepthSourceRegistry::with_builtins().create("rgbd", settings);
+  rgbl::SensorFrame frame;
+  CHECK_THROWS_WITH(source->prepare(frame), Contains("frame.depth_image"));
+  cv::Mat raw(48, 64, CV_16UC1, cv::Scalar(10000));  // 2 m at 5000 per metre
+  raw.at<std::uint16_t>(5, 5) = 0;
+  frame.depth_image = raw;
+  source->prepare(frame);
+  cv::Mat_<float> dense = source->dense_depth();
+  CHECK(dense(10, 10) == Approx(2.0F));
+  CHECK(dense(5, 5) == 0.0F);
+  std::vector<rgbl::KeypointDepth> out(1);
+  const std::vector<Eigen::Vector2f> pixels = {{5.0F, 4.0F}};
+  source->sample(pixels, out);
+  CHECK(out[0].z == Approx(2.0F));
+  CHECK(out[0].spread == 0.0F);  // the hole at (5, 5) is not a depth
+  frame.depth_image = cv::Mat(48, 64, CV_32FC1, cv::Scalar(std::nanf("")));
+  source->prepare(frame);
+  CHECK(cv::countNonZero(source->dense_depth()) == 0);
+  frame.depth_image = cv::Mat(48, 64, CV_8UC1, cv::Scalar(1));
+  CHECK_THROWS_WITH(source->prepare(frame), Contains("CV_16UC1"));
+  frame.depth_image = cv::Mat(10, 10, CV_16UC1, cv::Scalar(1));
+  CHECK_THROWS_WITH(source->prepare(frame), Contains("64x48"));
+  settings.rgbd.scale = 0.0;
+  CHECK_THROWS_WITH(rgbl::DepthSourceRegistry::with_builtins().create("rgbd", settings), Contains("rgbd.scale"));
+}
+
+TEST_CASE("stereo source: depth = fx * baseline / disparity on a shifted texture") {
+  auto settings = simple_settings();
+  CHECK_THROWS_WITH(rgbl::DepthSourceRegistry::with_builtins().create("stereo", settings), Contains("stereo_baseline"));
+  settings.calibration.camera.width = 160;
+  settings.calibration.camera.height = 80;
+  settings.stereo_baseline = 0.5;
+  settings.stereo.num_disparities = 16;
+  auto source = rgbl::DepthSourceRegistry::with_builtins().create("stereo", settings);
+  rgbl::SensorFrame frame;
+  CHECK_THROWS_WITH(source->prepare(frame), Contains("image_right"));
+  // a random texture seen 8 px further left in the right image: disparity 8, z = 100 * 0.5 / 8
+  cv::Mat texture(80, 200, CV_8UC1);
+  cv::randu(texture, 0, 255);
+  frame.image = texture.colRange(20, 180).clone();
+  frame.image_right = texture.colRange(28, 188).clone();
+  source->prepare(frame);
+  const cv::Mat_<float> dense = source->dense_depth();
+  const std::vector<Eigen::Vector2f> pixels = {{100.0F, 40.0F}};
+  std::vector<rgbl::KeypointDepth> out(1);
+  source->sample(pixels, out);
+  CHECK(out[0].z == Approx(100.0 * 0.5 / 8.0).epsilon(0.02));
+  CHECK(rgbl::depth_density(dense.colRange(40, 150)) > 0.9);
+  frame.image_right = cv::Mat(10, 10, CV_8UC1, cv::Scalar(0));
+  CHECK_THROWS_WITH(source->prepare(frame), Contains("frame.image_right"));
+}
+
+TEST_CASE("lidar source with IP-Basic completion samples its dense map") {
+  auto settings = simple_settings();
+  settings.lidar.completion = rgbl::parse_completion_method("ip_basic_fast");
+  CHECK_THROWS_WITH(rgbl::parse_completion_method("neural"), Contains("lidar.completion"));
+  auto source = rgbl::DepthSourceRegistry::with_builtins().create("lidar", settings);
+  std::vector<rgbl::LidarPoint> scan;
+  for (int y = -20; y <= 20; y += 4)
+    for (int x = -30; x <= 30; x += 4) scan.push_back({static_cast<float>(x) * 0.2F, static_cast<float>(y) * 0.2F, 20.0F, 0.0F});
+  rgbl::SensorFrame frame;
+  frame.scan = scan;
+  source->prepare(frame);
+  const cv::Mat_<float> dense = source->dense_depth();
+  CHECK(rgbl::depth_density(dense) > 0.8);
+  const std::vector<Eigen::Vector2f> pixels = {{34.0F, 26.0F}};  // samples at columns 2, 6, .., 34 and rows 4, 8, .., 28
+  std::vector<rgbl::KeypointDepth> out(1);
+  source->sample(pixels, out);
+  CHECK(out[0].z == Approx(20.0F).margin(1e-3));
+  CHECK(out[0].sample_distance_px == Approx(2.0F));  // (34, 24) and (34, 28)
+}
