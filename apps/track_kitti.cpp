@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   app.add_option("sequence", sequence, "KITTI odometry sequence folder (.../sequences/NN)")->required();
   app.add_option("--camera", options.camera, "tracked camera (0 grey, 2 colour)")->check(CLI::IsMember({0, 2}));
   app.add_option("--frames", options.frames, "number of frames (default: all)");
+  app.add_option("--depth", options.depth, "depth source: lidar or stereo (needs image_<camera+1>)")
+      ->check(CLI::IsMember({"lidar", "stereo"}));
   app.add_option("--output", output, "write the cam0 trajectory in KITTI format");
   app.add_flag("--threaded", threaded, "local mapping in its own thread");
   app.add_flag("--verbose", options.verbose, "one line per frame");
