@@ -60,7 +60,7 @@ struct RunSummary {
   double ate_rmse = 0.0, drift_percent = 0.0, path_length = 0.0, scale_ratio = 0.0;
   double median_depth_ms = 0.0, median_extraction_ms = 0.0, median_tracking_ms = 0.0, median_mapping_ms = 0.0;
   double median_front_ms = 0.0;  // depth + extraction + tracking
-  double median_total_ms = 0.0, mean_total_ms = 0.0;
+  double median_total_ms = 0.0, mean_total_ms = 0.0, mean_mapping_ms = 0.0;
   std::vector<Eigen::Isometry3d> estimate;  // T_world_cam0 per frame (world = first cam0)
   std::vector<Eigen::Isometry3d> truth;
 };
@@ -155,6 +155,9 @@ inline RunSummary run_kitti_sequence(const std::filesystem::path& sequence, cons
   double sum = 0.0;
   for (const double t : total_ms) sum += t;
   summary.mean_total_ms = sum / static_cast<double>(total_ms.size());
+  double mapping_sum = 0.0;
+  for (const double t : mapping_ms) mapping_sum += t;
+  summary.mean_mapping_ms = mapping_sum / static_cast<double>(mapping_ms.size());
 
   // Poses in the cam0 frame: T_world_cam0 = T_world_cam * T_cam_cam0, world = first cam0.
   const Eigen::Isometry3d T_cam_cam0 = calibration.T_cam_cam0;
