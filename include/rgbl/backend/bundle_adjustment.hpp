@@ -1,0 +1,69 @@
+#pragma once
+// Local bundle adjustment on Ceres (private to this module): keyframe poses and landmark positions
+// with reprojection and depth residuals, Huber loss, Schur elimination, some poses held fixed, and an
+// abort flag that stops the solve between iterations.
+
+#include "rgbl/geometry/camera.hpp"
+#include "rgbl/geometry/se3.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <atomic>
+#include <vector>
+
+namespace rgbl {
+
+struct BundlePose {
+  Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();
+  bool fixed = false;
+};
+
+struct BundleObservation {
+  int pose = 0;      // index into BundleProblem::poses
+  int point = 0;     // index into BundleProblem::points
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
+  double sigma_px = 1.0;
+  double depth = 0.0;        // 0 = reprojection only
+  double depth_sigma = 0.0;
+};
+
+struct BundleProblem {
+  std::vector<BundlePose> poses;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<BundleObservation> observations;
+};
+
+struct BundleAdjustmentOptions {
+  int iterations = 10;
+  double chi2_2d = 5.991, chi2_3d = 7.815;  // Huber thresholds and outlier tests
+  bool dense_schur = true;   // DENSE_SCHUR (small local windows) or SPARSE_SCHUR
+  int threads = 1;
+
+  void validate() const;
+};
+
+struct BundleAdjustmentResult {
+  std::vector<bool> outlier;  // per observation, chi2 above the threshold after the solve
+  int iterations = 0;
+  bool aborted = false;
+  double initial_cost = 0.0, final_cost = 0.0;
+};
+
+// Optimises problem.poses (non-fixed) and problem.points in place.
+BundleAdjustmentResult bundle_adjust(const PinholeCamera& camera, BundleProblem& problem,
+                                     const BundleAdjustmentOptions& options = {},
+                                     const std::atomic<bool>* abort = nullptr);
+
+// The residual bundle_adjust minimises for one observation, evaluated through the same Ceres cost
+// function, with Jacobians w.r.t. the pose parameters [angle-axis(3), translation(3)] of T_cam_world
+// and the point: for tests against numeric differentiation. Returns the residual dimension (2 or 3).
+int bundle_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world, const Eigen::Vector3d& point,
+                    const BundleObservation& observation, Eigen::Vector3d& residual,
+                    Eigen::Matrix<double, 3, 6>& d_pose, Eigen::Matrix3d& d_point);
+
+// The pose parameterisation bundle_residual differentiates by.
+Vector6d pose_to_parameters(const Eigen::Isometry3d& T);
+Eigen::Isometry3d parameters_to_pose(const Vector6d& parameters);
+
+}  // namespace rgbl

@@ -1,0 +1,58 @@
+#pragma once
+// Pose-only optimisation of one camera against known 3-D points: a hand-written Gauss-Newton on SE(3)
+// with analytic Jacobians (a per-frame Ceres solve costs more in overhead than the whole problem),
+// Huber weights and rounds of outlier re-classification as in ORB-SLAM.
+
+#include "rgbl/geometry/camera.hpp"
+#include "rgbl/geometry/se3.hpp"
+
+#include <Eigen/Core>
+
+#include <span>
+#include <vector>
+
+namespace rgbl {
+
+// One 2-D (and optionally depth) measurement of a known world point.
+struct PoseObservation {
+  Eigen::Vector3d p_world = Eigen::Vector3d::Zero();
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
+  double sigma_px = 1.0;     // pixel standard deviation (ORB: scale factor ^ level)
+  double depth = 0.0;        // measured camera z, metres; 0 = 2-D observation only
+  double depth_sigma = 0.0;  // metres; used when depth > 0
+};
+
+struct PoseOptimizerOptions {
+  int rounds = 4;              // outlier re-classification rounds
+  int iterations = 10;         // Gauss-Newton iterations per round
+  double chi2_2d = 5.991;      // 95% of chi2 with 2 dof
+  double chi2_3d = 7.815;      // 95% of chi2 with 3 dof
+  bool robust_last_round = false;  // ORB-SLAM drops the robust kernel in the last rounds
+  // Huber's influence never vanishes: a few points with a small depth sigma that move with the camera
+  // (a car ahead) pull the first round off. With cauchy the influence of residuals far beyond the
+  // threshold fades (weight 1 / (1 + e^2 / c^2)).
+  bool cauchy = false;
+  double min_depth = 1e-3;     // points closer than this to the camera plane are outliers
+
+  void validate() const;
+};
+
+struct PoseOptimizerResult {
+  Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();
+  std::vector<bool> inlier;    // per observation
+  int inliers = 0;
+  double final_chi2 = 0.0;     // sum over inliers
+};
+
+// Residual of one observation at pose T_cam_world, whitened by its sigmas: 2 or 3 entries
+// (u, v, then z when the observation has depth). jacobian (rows as residual) is with respect to a
+// left perturbation T <- exp(xi) * T, xi = [rho; phi]. Returns false when the point is behind.
+bool pose_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world, const PoseObservation& obs,
+                   Eigen::Vector3d& residual, Eigen::Matrix<double, 3, 6>& jacobian, int& dimension);
+
+// Distortion of the camera is ignored: keypoints are expected in rectified, undistorted images.
+PoseOptimizerResult optimize_pose(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world_initial,
+                                  std::span<const PoseObservation> observations,
+                                  const PoseOptimizerOptions& options = {});
+
+}  // namespace rgbl

@@ -1,0 +1,75 @@
+#pragma once
+// Every threshold of tracking and local mapping, with ORB-SLAM3's RGB-D values as defaults where the
+// SPEC gives them.
+
+#include "rgbl/backend/bundle_adjustment.hpp"
+#include "rgbl/backend/depth_noise.hpp"
+#include "rgbl/backend/pose_optimizer.hpp"
+#include "rgbl/map/map.hpp"
+
+namespace rgbl {
+
+struct TrackerOptions {
+  int min_initial_depth_points = 300;   // keypoints with usable depth to initialise
+  double motion_radius = 15.0;          // px at level 0, guided matching with the motion model
+  int motion_min_matches = 20;          // retry with 2x radius below this
+  int motion_max_hamming = 100;
+  double motion_ratio = 1.0;            // best/second-best test on the same level (1 = off, as ORB-SLAM)
+  double local_map_radius = 3.0;        // px at level 0, local-map search
+  int max_hamming = 100;
+  int max_hamming_strict = 50;
+  double local_map_ratio = 0.8;
+  double reference_ratio = 0.7;         // brute-force fallback against the reference keyframe
+  double min_view_cos = 0.5;            // viewing-angle test
+  int max_local_keyframes = 80;
+  int min_pose_inliers = 10;            // pose optimisation success
+  int min_local_map_inliers = 30;       // local-map tracking success
+  int relocalisation_min_inliers = 50;
+  std::size_t recent_loss_frames = 5;   // after a loss, try the motion model this long before relocalising
+  bool check_orientation = true;        // rotation histogram consistency in guided matching
+  // Depth gate in guided matching (0 sigmas = off): |measured - predicted z| <= max(min, sigmas * sigma).
+  double depth_gate_sigmas = 3.0;
+  double depth_gate_min_motion = 1.0;     // m, around the constant-velocity prediction
+  double depth_gate_min_local_map = 0.3;  // m, around the motion-model pose
+  // Prediction from depth-to-depth RANSAC between consecutive frames instead of constant velocity
+  bool ransac_prediction = true;
+  int ransac_max_hamming = 64;
+  double ransac_ratio = 0.7;
+  int ransac_iterations = 100;
+  std::size_t ransac_max_points = 350;     // current keypoints with depth used (strided subset)
+  int ransac_min_inliers = 30;
+  double ransac_min_tolerance = 0.2;       // m
+  double ransac_relative_tolerance = 0.03; // of z
+  bool temporary_points = true;         // last-frame depth points without landmark join the motion model
+  // Keyframe decision (SPEC section 5)
+  int max_frames_between_keyframes = 10;
+  double reference_ratio_threshold = 0.75;
+  int close_tracked_threshold = 100, close_untracked_threshold = 70;
+  int min_keyframe_inliers = 15;
+  double close_depth = 97.0;            // m; "close" points (RGB-L: bf/fx * ThDepth = 100/707 * 700)
+
+  PoseOptimizerOptions pose;
+
+  void validate() const;
+};
+
+struct LocalMappingOptions {
+  int min_new_depth_points = 100;       // at least this many new landmarks from depth per keyframe
+  int max_new_depth_points = 1000;
+  int covisible_for_fusion = 10;
+  double fusion_radius = 3.0;           // px at level 0
+  int max_local_ba_keyframes = 10;      // optimised keyframes (the current one and its best covisible)
+  int max_fixed_keyframes = 20;
+  double min_found_ratio = 0.25;        // landmark culling
+  int min_observations = 3;             // landmark culling after 2 keyframes
+  double redundant_ratio = 0.9;         // keyframe culling
+  int redundant_observers = 3;
+  bool local_ba = true;
+  bool keyframe_culling = true;
+  bool fusion = true;
+  BundleAdjustmentOptions ba;
+
+  void validate() const;
+};
+
+}  // namespace rgbl

@@ -1,0 +1,96 @@
+#pragma once
+// The facade: one call per frame from sensor data to a pose. Owns the map, the tracker, local mapping
+// (inline, deterministic, or in its own thread), the depth source and the feature extractor.
+
+#include "rgbl/backend/depth_noise.hpp"
+#include "rgbl/depth/depth_source.hpp"
+#include "rgbl/geometry/calibration.hpp"
+#include "rgbl/map/map.hpp"
+#include "rgbl/tracking/frame.hpp"
+#include "rgbl/tracking/options.hpp"
+#include "rgbl/tracking/tracker.hpp"
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+namespace rgbl {
+
+struct SystemOptions {
+  TrackerOptions tracker;
+  LocalMappingOptions mapping;
+  DepthNoiseModel depth_noise;
+  MapOptions map;
+  // false: local mapping runs inside track() and the same input gives a bit-identical trajectory.
+  bool threaded_mapping = false;
+  // Motion compensation of LiDAR depth: a spinning LiDAR measures a point at azimuth a (0 = ahead,
+  // positive to the left) at a time offset of -spin * a / (2 pi) * scan_period from the camera
+  // trigger (taken when the LiDAR faces forward, as on KITTI). With the constant-velocity estimate the
+  // keypoint depth is moved to the camera time. At 14 m/s a point 60 degrees to the side is off by
+  // ~0.25 m, which is a scale bias when one side dominates. 0 = off.
+  double lidar_scan_period = 0.0;      // s (KITTI HDL-64E: 0.1)
+  double lidar_spin = 1.0;             // +1: left side scanned before the front (clockwise from above)
+  double frame_period = 0.1;           // s between frames, to scale the velocity
+
+  void validate() const;
+};
+
+// Milliseconds spent per stage on one frame. mapping_ms is the inline local-mapping time (0 when
+// mapping runs in its own thread).
+struct StageTiming {
+  double depth_ms = 0.0;       // prepare + keypoint sampling
+  double extraction_ms = 0.0;
+  double tracking_ms = 0.0;
+  double mapping_ms = 0.0;
+  double total_ms = 0.0;
+};
+
+struct TrackResult {
+  std::size_t frame_index = 0;
+  double timestamp = 0.0;
+  TrackState state = TrackState::NotInitialised;
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();  // world = first tracked camera pose
+  bool keyframe = false;
+  int inliers = 0;
+  int keypoints = 0, keypoints_with_depth = 0;
+  StageTiming timing;
+};
+
+struct TrajectoryPose {
+  std::size_t frame_index = 0;
+  double timestamp = 0.0;
+  TrackState state = TrackState::NotInitialised;
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+};
+
+class System {
+ public:
+  System(SystemOptions options, CameraCalibration calibration, std::unique_ptr<DepthSource> depth,
+         FeatureExtractor extractor);
+  ~System();
+  System(const System&) = delete;
+  System& operator=(const System&) = delete;
+
+  // Throws only what the depth source throws on unusable input (e.g. no scan for a LiDAR source).
+  TrackResult track(const SensorFrame& frame);
+
+  // Waits until threaded mapping has processed every queued keyframe (no-op when inline).
+  void finish();
+
+  // Every frame so far, with poses refined by mapping (frames are stored relative to their reference
+  // keyframe, as ORB-SLAM does).
+  std::vector<TrajectoryPose> trajectory() const;
+
+  // Lock map().mutex() (shared) to read while threaded mapping runs.
+  const Map& map() const;
+  const CameraCalibration& calibration() const;
+
+ struct Impl;  // public name only so that helpers in the .cpp can take it
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rgbl

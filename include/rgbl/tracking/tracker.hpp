@@ -1,0 +1,69 @@
+#pragma once
+// The tracking state machine: not initialised -> ok <-> lost. Each frame is matched against the map
+// (motion model, reference-keyframe fallback, local map, relocalisation) and its pose optimised; the
+// tracker also decides when a frame becomes a keyframe. It never throws on bad input: failure is a
+// state.
+
+#include "rgbl/geometry/camera.hpp"
+#include "rgbl/map/map.hpp"
+#include "rgbl/tracking/frame.hpp"
+#include "rgbl/tracking/options.hpp"
+
+#include <optional>
+
+namespace rgbl {
+
+enum class TrackState { NotInitialised, Ok, Lost };
+
+const char* to_string(TrackState state);
+
+struct TrackerOutcome {
+  TrackState state = TrackState::NotInitialised;
+  bool initialised_now = false;
+  bool relocalised = false;
+  bool need_keyframe = false;
+  int inliers = 0;
+};
+
+class Tracker {
+ public:
+  Tracker(Map& map, const PinholeCamera& camera, TrackerOptions options);
+
+  // Tracks the frame (sets frame.T_cam_world, landmarks, outliers). When initialised_now or
+  // need_keyframe, the caller turns the frame into a keyframe with make_keyframe().
+  TrackerOutcome track(Frame& frame, bool mapping_idle);
+
+  // Adds the frame as a keyframe to the map (taking the map lock) and makes it the reference.
+  KeyframeId make_keyframe(const Frame& frame);
+
+  TrackState state() const { return state_; }
+  KeyframeId reference_keyframe() const { return reference_; }
+  // Constant-velocity motion T_cur_last of the last tracked frame pair, if any.
+  const std::optional<Eigen::Isometry3d>& velocity() const { return velocity_; }
+
+ private:
+  bool initialise(Frame& frame);
+  bool track_with_motion_model(Frame& frame);
+  bool track_reference_keyframe(Frame& frame);
+  bool track_local_map(Frame& frame);
+  bool relocalise(Frame& frame);
+  // extra: (keypoint, world point) correspondences that are not landmarks (temporary points).
+  int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {});
+  bool need_keyframe(const Frame& frame, int inliers, bool mapping_idle) const;
+  void update_local_map(const Frame& frame);
+
+  Map& map_;
+  PinholeCamera camera_;
+  TrackerOptions options_;
+  TrackState state_ = TrackState::NotInitialised;
+  KeyframeId reference_;
+  std::size_t last_keyframe_frame_ = 0;
+  std::size_t last_relocalisation_frame_ = 0;
+  std::size_t last_ok_frame_ = 0;
+  std::optional<Frame> last_frame_;
+  std::optional<Eigen::Isometry3d> velocity_;  // T_cur_last
+  std::vector<KeyframeId> local_keyframes_;
+  std::vector<LandmarkId> local_landmarks_;
+};
+
+}  // namespace rgbl

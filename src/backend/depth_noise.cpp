@@ -1,0 +1,31 @@
+#include "rgbl/backend/depth_noise.hpp"
+
+#include "rgbl/core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rgbl {
+
+void DepthNoiseModel::validate() const {
+  require(sigma_min > 0.0, "depth_noise.sigma_min", "> 0");
+  require(sigma_relative >= 0.0, "depth_noise.sigma_relative", ">= 0");
+  require(sigma_per_pixel >= 0.0, "depth_noise.sigma_per_pixel", ">= 0");
+  require(sigma_quadratic >= 0.0, "depth_noise.sigma_quadratic", ">= 0");
+  require(max_spread > 0.0, "depth_noise.max_spread", "> 0");
+  require(max_spread_relative >= 0.0, "depth_noise.max_spread_relative", ">= 0");
+  require(min_depth > 0.0 && max_depth > min_depth, "depth_noise.min_depth/max_depth", "0 < min_depth < max_depth");
+  require(max_sigma_relative > 0.0, "depth_noise.max_sigma_relative", "> 0");
+}
+
+double DepthNoiseModel::sigma(double z, double sample_distance_px, double spread, double fx) const {
+  if (!(z >= min_depth && z <= max_depth)) return 0.0;
+  if (spread > std::max(max_spread, max_spread_relative * z)) return 0.0;
+  const double from_pixel = sigma_per_pixel * sample_distance_px * z * z / fx;
+  const double relative = sigma_relative * z;
+  const double quadratic = sigma_quadratic * z * z;
+  const double s = std::sqrt(sigma_min * sigma_min + relative * relative + from_pixel * from_pixel + quadratic * quadratic);
+  return s > max_sigma_relative * z ? 0.0 : s;
+}
+
+}  // namespace rgbl

@@ -1,0 +1,113 @@
+#include "rgbl/backend/pose_optimizer.hpp"
+
+#include "rgbl/core/error.hpp"
+
+#include <Eigen/Cholesky>
+
+#include <cmath>
+
+namespace rgbl {
+
+void PoseOptimizerOptions::validate() const {
+  require(rounds >= 1, "pose_optimizer.rounds", ">= 1");
+  require(iterations >= 1, "pose_optimizer.iterations", ">= 1");
+  require(chi2_2d > 0.0 && chi2_3d > 0.0, "pose_optimizer.chi2", "> 0");
+}
+
+bool pose_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world, const PoseObservation& obs,
+                   Eigen::Vector3d& residual, Eigen::Matrix<double, 3, 6>& jacobian, int& dimension) {
+  const Eigen::Vector3d p = T_cam_world * obs.p_world;
+  dimension = obs.depth > 0.0 && obs.depth_sigma > 0.0 ? 3 : 2;
+  if (p.z() <= 1e-6) return false;
+  const double iz = 1.0 / p.z();
+  const double u = camera.fx * p.x() * iz + camera.cx;
+  const double v = camera.fy * p.y() * iz + camera.cy;
+  const double w = 1.0 / obs.sigma_px;
+  residual(0) = (u - obs.pixel.x()) * w;
+  residual(1) = (v - obs.pixel.y()) * w;
+  // d(u,v,z)/dp
+  Eigen::Matrix3d dproj;
+  dproj << camera.fx * iz, 0.0, -camera.fx * p.x() * iz * iz,  //
+      0.0, camera.fy * iz, -camera.fy * p.y() * iz * iz,        //
+      0.0, 0.0, 1.0;
+  // dp/dxi for a left perturbation: [I, -hat(p)]
+  Eigen::Matrix<double, 3, 6> dp;
+  dp.leftCols<3>().setIdentity();
+  dp.rightCols<3>() = -hat(p);
+  jacobian = dproj * dp;
+  jacobian.row(0) *= w;
+  jacobian.row(1) *= w;
+  if (dimension == 3) {
+    const double wz = 1.0 / obs.depth_sigma;
+    residual(2) = (p.z() - obs.depth) * wz;
+    jacobian.row(2) *= wz;
+  } else {
+    residual(2) = 0.0;
+    jacobian.row(2).setZero();
+  }
+  return true;
+}
+
+PoseOptimizerResult optimize_pose(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world_initial,
+                                  std::span<const PoseObservation> observations,
+                                  const PoseOptimizerOptions& options) {
+  PoseOptimizerResult result;
+  result.T_cam_world = T_cam_world_initial;
+  result.inlier.assign(observations.size(), true);
+  if (observations.size() < 3) {
+    result.inliers = 0;
+    result.inlier.assign(observations.size(), false);
+    return result;
+  }
+  Eigen::Vector3d r;
+  Eigen::Matrix<double, 3, 6> J;
+  int dim = 2;
+  for (int round = 0; round < options.rounds; ++round) {
+    const bool robust = round < options.rounds - 1 || options.robust_last_round;
+    for (int it = 0; it < options.iterations; ++it) {
+      Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+      Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+      int used = 0;
+      for (std::size_t i = 0; i < observations.size(); ++i) {
+        if (!result.inlier[i]) continue;
+        if (!pose_residual(camera, result.T_cam_world, observations[i], r, J, dim)) continue;
+        const double e2 = r.squaredNorm();
+        double weight = 1.0;
+        if (robust) {
+          const double delta2 = dim == 3 ? options.chi2_3d : options.chi2_2d;
+          if (options.cauchy) {
+            weight = 1.0 / (1.0 + e2 / delta2);
+          } else if (e2 > delta2) {
+            weight = std::sqrt(delta2 / e2);
+          }
+        }
+        H.noalias() += weight * J.transpose() * J;
+        g.noalias() += weight * J.transpose() * r;
+        ++used;
+      }
+      if (used < 3) break;
+      const Vector6d dx = H.ldlt().solve(-g);
+      if (!dx.allFinite()) break;
+      result.T_cam_world = se3_exp(dx) * result.T_cam_world;
+      if (dx.squaredNorm() < 1e-16) break;
+    }
+    // Re-classify every observation (outliers may come back) by its chi2 at the current pose.
+    result.inliers = 0;
+    result.final_chi2 = 0.0;
+    for (std::size_t i = 0; i < observations.size(); ++i) {
+      const bool ok = pose_residual(camera, result.T_cam_world, observations[i], r, J, dim);
+      const Eigen::Vector3d p = result.T_cam_world * observations[i].p_world;
+      const double e2 = r.squaredNorm();
+      const bool in = ok && p.z() > options.min_depth && e2 <= (dim == 3 ? options.chi2_3d : options.chi2_2d);
+      result.inlier[i] = in;
+      if (in) {
+        ++result.inliers;
+        result.final_chi2 += e2;
+      }
+    }
+    if (result.inliers < 10) break;
+  }
+  return result;
+}
+
+}  // namespace rgbl

@@ -1,0 +1,154 @@
+#include "matching.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <array>
+#include <climits>
+#include <cmath>
+
+namespace rgbl::detail {
+namespace {
+
+// Without -mpopcnt, std::popcount is a library call (__popcountdi2) that dominated the tracker's
+// profile; the SWAR count below is branch-free and a few instructions per word.
+inline int popcount64(std::uint64_t x) noexcept {
+#if defined(__POPCNT__)
+  return std::popcount(x);
+#else
+  x = x - ((x >> 1) & 0x5555555555555555ULL);
+  x = (x & 0x3333333333333333ULL) + ((x >> 2) & 0x3333333333333333ULL);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0FULL;
+  return static_cast<int>((x * 0x0101010101010101ULL) >> 56);
+#endif
+}
+
+inline int distance(const Descriptor& a, const Descriptor& b) noexcept {
+  int d = 0;
+  for (std::size_t i = 0; i < 32; i += 8) {
+    std::uint64_t wa = 0, wb = 0;
+    std::memcpy(&wa, a.data() + i, 8);
+    std::memcpy(&wb, b.data() + i, 8);
+    d += popcount64(wa ^ wb);
+  }
+  return d;
+}
+
+}  // namespace
+
+int descriptor_distance(const Descriptor& a, const Descriptor& b) noexcept { return distance(a, b); }
+
+int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates, int max_hamming, double ratio,
+                    bool check_orientation, std::vector<int>* candidate_of_keypoint, DepthGate gate) {
+  const std::size_t n = frame.size();
+  std::vector<int> best_distance(n, INT_MAX);
+  std::vector<int> owner(n, -1);  // candidate index holding the keypoint in this call
+  std::vector<int> cell;
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    const ProjectedLandmark& cand = candidates[c];
+    frame.grid.query(cand.x, cand.y, cand.radius, cand.min_level, cand.max_level, cell);
+    int best = INT_MAX, second = INT_MAX, best_index = -1, best_level = -1, second_level = -1;
+    for (const int k : cell) {
+      if (frame.landmarks[static_cast<std::size_t>(k)].valid() && owner[static_cast<std::size_t>(k)] < 0) continue;
+      if (gate.sigmas > 0.0F && cand.depth > 0.0F && frame.depth[static_cast<std::size_t>(k)] > 0.0F) {
+        const float gap = std::max(gate.min_gap, gate.sigmas * frame.depth_sigma[static_cast<std::size_t>(k)]);
+        if (std::abs(frame.depth[static_cast<std::size_t>(k)] - cand.depth) > gap) continue;
+      }
+      const int d = distance(*cand.descriptor, frame.descriptors[static_cast<std::size_t>(k)]);
+      if (d < best) {
+        second = best;
+        second_level = best_level;
+        best = d;
+        best_index = k;
+        best_level = frame.keypoints[static_cast<std::size_t>(k)].level;
+      } else if (d < second) {
+        second = d;
+        second_level = frame.keypoints[static_cast<std::size_t>(k)].level;
+      }
+    }
+    if (best_index < 0 || best > max_hamming) continue;
+    if (ratio < 1.0 && best_level == second_level && best > ratio * second) continue;
+    const auto k = static_cast<std::size_t>(best_index);
+    if (best >= best_distance[k]) continue;
+    best_distance[k] = best;
+    owner[k] = static_cast<int>(c);
+  }
+  // Rotation consistency: keep the three dominant bins of angle differences.
+  constexpr int kBins = 30;
+  std::array<std::vector<std::size_t>, kBins> bins;
+  std::vector<std::size_t> matched;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (owner[k] < 0) continue;
+    matched.push_back(k);
+    const ProjectedLandmark& cand = candidates[static_cast<std::size_t>(owner[k])];
+    if (check_orientation && cand.angle >= 0.0F) {
+      float rot = cand.angle - frame.keypoints[k].angle;
+      if (rot < 0.0F) rot += 360.0F;
+      const int bin = std::min(kBins - 1, static_cast<int>(std::lround(rot * kBins / 360.0F)) % kBins);
+      bins[static_cast<std::size_t>(bin)].push_back(k);
+    }
+  }
+  std::vector<char> keep(n, 1);
+  if (check_orientation) {
+    std::array<int, kBins> order{};
+    for (int i = 0; i < kBins; ++i) order[static_cast<std::size_t>(i)] = i;
+    std::sort(order.begin(), order.end(), [&](int a, int b) {
+      const auto sa = bins[static_cast<std::size_t>(a)].size(), sb = bins[static_cast<std::size_t>(b)].size();
+      return sa != sb ? sa > sb : a < b;
+    });
+    const std::size_t top = bins[static_cast<std::size_t>(order[0])].size();
+    for (int r = 0; r < kBins; ++r) {
+      const auto& bin = bins[static_cast<std::size_t>(order[static_cast<std::size_t>(r)])];
+      const bool dominant = r < 3 && static_cast<double>(bin.size()) >= 0.1 * static_cast<double>(top);
+      if (!dominant) {
+        for (const std::size_t k : bin) keep[k] = 0;
+      }
+    }
+  }
+  int count = 0;
+  if (candidate_of_keypoint != nullptr) candidate_of_keypoint->assign(n, -1);
+  for (const std::size_t k : matched) {
+    if (!keep[k]) continue;
+    const ProjectedLandmark& cand = candidates[static_cast<std::size_t>(owner[k])];
+    if (cand.id.valid()) frame.landmarks[k] = cand.id;
+    if (candidate_of_keypoint != nullptr) (*candidate_of_keypoint)[k] = owner[k];
+    frame.outlier[k] = false;
+    ++count;
+  }
+  return count;
+}
+
+std::vector<std::pair<int, int>> match_brute_force(std::span<const Descriptor> query,
+                                                   std::span<const Descriptor> train, int max_hamming,
+                                                   double ratio) {
+  std::vector<std::pair<int, int>> matches;
+  std::vector<int> best_for_train(train.size(), INT_MAX);
+  std::vector<int> query_for_train(train.size(), -1);
+  for (std::size_t q = 0; q < query.size(); ++q) {
+    int best = INT_MAX, second = INT_MAX, best_index = -1;
+    for (std::size_t t = 0; t < train.size(); ++t) {
+      const int d = distance(query[q], train[t]);
+      if (d < best) {
+        second = best;
+        best = d;
+        best_index = static_cast<int>(t);
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    if (best_index < 0 || best > max_hamming || best > ratio * second) continue;
+    const auto t = static_cast<std::size_t>(best_index);
+    if (best < best_for_train[t]) {
+      best_for_train[t] = best;
+      query_for_train[t] = static_cast<int>(q);
+    }
+  }
+  for (std::size_t t = 0; t < train.size(); ++t) {
+    if (query_for_train[t] >= 0) matches.emplace_back(query_for_train[t], static_cast<int>(t));
+  }
+  std::sort(matches.begin(), matches.end());
+  return matches;
+}
+
+}  // namespace rgbl::detail

@@ -1,0 +1,243 @@
+#include "rgbl/tracking/system.hpp"
+
+#include "rgbl/core/error.hpp"
+#include "rgbl/core/log.hpp"
+#include "rgbl/core/timer.hpp"
+#include "rgbl/tracking/local_mapping.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <shared_mutex>
+#include <thread>
+
+namespace rgbl {
+
+void SystemOptions::validate() const {
+  tracker.validate();
+  mapping.validate();
+  depth_noise.validate();
+  map.validate();
+}
+
+namespace {
+struct FrameRecord {
+  std::size_t frame_index = 0;
+  double timestamp = 0.0;
+  TrackState state = TrackState::NotInitialised;
+  KeyframeId reference;
+  Eigen::Isometry3d T_cam_reference = Eigen::Isometry3d::Identity();
+};
+}  // namespace
+
+struct System::Impl {
+  SystemOptions options;
+  CameraCalibration calibration;
+  std::unique_ptr<DepthSource> depth;
+  FeatureExtractor extractor;
+  Map map;
+  Tracker tracker;
+  LocalMapper mapper;
+  std::vector<FrameRecord> records;
+  std::vector<Eigen::Vector2f> pixels;
+  std::vector<KeypointDepth> depths;
+  cv::Mat gray;
+
+  // Threaded mapping.
+  std::thread thread;
+  std::mutex queue_mutex;
+  std::condition_variable queue_cv, idle_cv;
+  std::deque<KeyframeId> queue;
+  bool busy = false, stop = false;
+
+  Impl(SystemOptions o, CameraCalibration c, std::unique_ptr<DepthSource> d, FeatureExtractor e)
+      : options(o), calibration(c), depth(std::move(d)), extractor(std::move(e)), map(o.map),
+        tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping) {
+    if (options.threaded_mapping) thread = std::thread([this] { run_mapping(); });
+  }
+
+  void run_mapping() {
+    for (;;) {
+      KeyframeId next;
+      {
+        std::unique_lock lock(queue_mutex);
+        queue_cv.wait(lock, [&] { return stop || !queue.empty(); });
+        if (queue.empty()) return;
+        next = queue.front();
+        queue.pop_front();
+        busy = true;
+      }
+      mapper.process(next);
+      {
+        std::lock_guard lock(queue_mutex);
+        busy = false;
+      }
+      idle_cv.notify_all();
+    }
+  }
+
+  bool mapping_idle() {
+    if (!options.threaded_mapping) return true;
+    std::lock_guard lock(queue_mutex);
+    return !busy && queue.empty();
+  }
+};
+
+namespace {
+
+void compensate_lidar_motion(System::Impl& s, Frame& frame) {
+  const Vector6d xi = se3_log(*s.tracker.velocity());  // per frame period
+  const Eigen::Isometry3d T_lidar_cam = s.calibration.T_cam_lidar.inverse();
+  const double per_radian = s.options.lidar_spin * s.options.lidar_scan_period / (2.0 * M_PI) / s.options.frame_period;
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.depth[i] <= 0.0F) continue;
+    const Eigen::Vector3d p = s.calibration.camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y),
+                                                             frame.depth[i]);
+    const Eigen::Vector3d p_lidar = T_lidar_cam * p;
+    const double fraction = per_radian * std::atan2(p_lidar.y(), p_lidar.x());  // frames before the trigger
+    const Eigen::Vector3d corrected = se3_exp(fraction * xi) * p;
+    frame.depth[i] = static_cast<float>(corrected.z());
+  }
+}
+
+}  // namespace
+
+System::System(SystemOptions options, CameraCalibration calibration, std::unique_ptr<DepthSource> depth,
+               FeatureExtractor extractor) {
+  options.validate();
+  calibration.camera.validate();
+  if (!depth) throw ConfigError("depth", "a depth source");
+  if (!extractor) throw ConfigError("extractor", "a feature extractor");
+  impl_ = std::make_unique<Impl>(options, calibration, std::move(depth), std::move(extractor));
+}
+
+System::~System() {
+  if (impl_ && impl_->thread.joinable()) {
+    {
+      std::lock_guard lock(impl_->queue_mutex);
+      impl_->stop = true;
+    }
+    impl_->mapper.request_abort();
+    impl_->queue_cv.notify_all();
+    impl_->thread.join();
+  }
+}
+
+void System::finish() {
+  if (!impl_->options.threaded_mapping) return;
+  std::unique_lock lock(impl_->queue_mutex);
+  impl_->idle_cv.wait(lock, [&] { return !impl_->busy && impl_->queue.empty(); });
+}
+
+TrackResult System::track(const SensorFrame& sensor) {
+  Impl& s = *impl_;
+  TrackResult result;
+  result.frame_index = sensor.index;
+  result.timestamp = sensor.timestamp;
+  Stopwatch total, stage;
+
+  s.depth->prepare(sensor);
+  result.timing.depth_ms = stage.lap_ms();
+
+  if (sensor.image.channels() == 3) cv::cvtColor(sensor.image, s.gray, cv::COLOR_BGR2GRAY);
+  else s.gray = sensor.image;
+  Frame frame;
+  frame.index = sensor.index;
+  frame.timestamp = sensor.timestamp;
+  s.extractor(s.gray, frame.keypoints, frame.descriptors);
+  result.timing.extraction_ms = stage.lap_ms();
+
+  const std::size_t n = frame.keypoints.size();
+  s.pixels.resize(n);
+  s.depths.assign(n, KeypointDepth{});
+  for (std::size_t i = 0; i < n; ++i) s.pixels[i] = Eigen::Vector2f(frame.keypoints[i].x, frame.keypoints[i].y);
+  s.depth->sample(s.pixels, s.depths);
+  frame.depth.resize(n);
+  frame.depth_sigma.resize(n);
+  int with_depth = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const KeypointDepth& d = s.depths[i];
+    const double sigma = d.z > 0.0F ? s.options.depth_noise.sigma(d.z, d.sample_distance_px, d.spread,
+                                                                   s.calibration.camera.fx)
+                                    : 0.0;
+    frame.depth[i] = sigma > 0.0 ? d.z : 0.0F;
+    frame.depth_sigma[i] = static_cast<float>(sigma);
+    with_depth += sigma > 0.0 ? 1 : 0;
+  }
+  if (s.options.lidar_scan_period > 0.0 && s.tracker.state() == TrackState::Ok && s.tracker.velocity()) {
+    compensate_lidar_motion(s, frame);
+  }
+  frame.build_grid(s.calibration.camera.width, s.calibration.camera.height);
+  result.timing.depth_ms += stage.lap_ms();
+
+  const TrackerOutcome outcome = s.tracker.track(frame, s.mapping_idle());
+  KeyframeId new_keyframe;
+  if (outcome.need_keyframe) new_keyframe = s.tracker.make_keyframe(frame);
+  result.timing.tracking_ms = stage.lap_ms();
+
+  if (new_keyframe.valid()) {
+    if (s.options.threaded_mapping) {
+      {
+        std::lock_guard lock(s.queue_mutex);
+        s.queue.push_back(new_keyframe);
+      }
+      s.queue_cv.notify_one();
+    } else {
+      s.mapper.process(new_keyframe);
+    }
+  }
+  result.timing.mapping_ms = stage.lap_ms();
+
+  result.state = outcome.state;
+  result.keyframe = outcome.initialised_now || new_keyframe.valid();
+  result.inliers = outcome.inliers;
+  result.keypoints = static_cast<int>(n);
+  result.keypoints_with_depth = with_depth;
+  result.T_world_cam = frame.T_cam_world.inverse();
+
+  FrameRecord record;
+  record.frame_index = sensor.index;
+  record.timestamp = sensor.timestamp;
+  record.state = outcome.state;
+  {
+    std::shared_lock lock(s.map.mutex());
+    record.reference = s.tracker.reference_keyframe();
+    if (const auto T_ref_world = s.map.keyframe_pose(record.reference)) {
+      record.T_cam_reference = frame.T_cam_world * T_ref_world->inverse();
+    } else {
+      record.reference = KeyframeId{};
+      record.T_cam_reference = frame.T_cam_world;
+    }
+  }
+  s.records.push_back(record);
+  result.timing.total_ms = total.elapsed_ms();
+  return result;
+}
+
+std::vector<TrajectoryPose> System::trajectory() const {
+  const Impl& s = *impl_;
+  std::vector<TrajectoryPose> out;
+  out.reserve(s.records.size());
+  std::shared_lock lock(s.map.mutex());
+  for (const FrameRecord& r : s.records) {
+    TrajectoryPose p;
+    p.frame_index = r.frame_index;
+    p.timestamp = r.timestamp;
+    p.state = r.state;
+    Eigen::Isometry3d T_cam_world = r.T_cam_reference;
+    if (r.reference.valid()) {
+      if (const auto T_ref_world = s.map.keyframe_pose(r.reference)) T_cam_world = r.T_cam_reference * *T_ref_world;
+    }
+    p.T_world_cam = T_cam_world.inverse();
+    out.push_back(p);
+  }
+  return out;
+}
+
+const Map& System::map() const { return impl_->map; }
+const CameraCalibration& System::calibration() const { return impl_->calibration; }
+
+}  // namespace rgbl

@@ -1,0 +1,547 @@
+#include "rgbl/tracking/tracker.hpp"
+
+#include "matching.hpp"
+#include "rgbl/backend/pose_optimizer.hpp"
+
+#include <opencv2/calib3d.hpp>
+
+#include <algorithm>
+#include <random>
+#include <cmath>
+#include <mutex>
+#include <shared_mutex>
+
+namespace rgbl {
+
+const char* to_string(TrackState state) {
+  switch (state) {
+    case TrackState::NotInitialised: return "not_initialised";
+    case TrackState::Ok: return "ok";
+    case TrackState::Lost: return "lost";
+  }
+  return "unknown";
+}
+
+Tracker::Tracker(Map& map, const PinholeCamera& camera, TrackerOptions options)
+    : map_(map), camera_(camera), options_(options) {
+  options_.validate();
+}
+
+namespace {
+
+double level_scale(const Map& map, int level) { return std::pow(map.options().scale_factor, level); }
+
+void clear_matches(Frame& frame) {
+  std::fill(frame.landmarks.begin(), frame.landmarks.end(), LandmarkId{});
+  std::fill(frame.outlier.begin(), frame.outlier.end(), false);
+}
+
+void discard_outliers(Frame& frame) {
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.outlier[i]) {
+      frame.landmarks[i] = LandmarkId{};
+      frame.outlier[i] = false;
+    }
+  }
+}
+
+}  // namespace
+
+TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
+  TrackerOutcome outcome;
+  frame.landmarks.assign(frame.size(), LandmarkId{});
+  frame.outlier.assign(frame.size(), false);
+  if (state_ == TrackState::NotInitialised) {
+    if (initialise(frame)) {
+      state_ = TrackState::Ok;
+      outcome.initialised_now = true;
+      outcome.inliers = static_cast<int>(std::count_if(frame.landmarks.begin(), frame.landmarks.end(),
+                                                       [](LandmarkId l) { return l.valid(); }));
+    }
+    outcome.state = state_;
+    last_frame_ = frame;
+    last_frame_->grid = KeypointGrid();
+    return outcome;
+  }
+
+  const Eigen::Isometry3d T_last = last_frame_ ? last_frame_->T_cam_world : Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d T_predicted = velocity_ ? *velocity_ * T_last : T_last;
+  bool ok = false;
+  if (state_ == TrackState::Ok) {
+    if (velocity_ && last_frame_) ok = track_with_motion_model(frame);
+    if (!ok) {
+      clear_matches(frame);
+      ok = track_reference_keyframe(frame);
+    }
+  } else {
+    // Recently lost: the frame-to-frame motion (depth RANSAC + temporary points) usually still holds
+    // and keeps the trajectory continuous; otherwise relocalise against the whole map.
+    if (velocity_ && last_frame_ && frame.index <= last_ok_frame_ + options_.recent_loss_frames) {
+      ok = track_with_motion_model(frame);
+      if (!ok) clear_matches(frame);
+    }
+    if (!ok) {
+      ok = relocalise(frame);
+      outcome.relocalised = ok;
+    }
+  }
+  int inliers = 0;
+  if (ok) {
+    ok = track_local_map(frame);
+    inliers = static_cast<int>(std::count_if(frame.landmarks.begin(), frame.landmarks.end(),
+                                             [](LandmarkId l) { return l.valid(); }));
+  }
+  if (ok) {
+    state_ = TrackState::Ok;
+    last_ok_frame_ = frame.index;
+    if (last_frame_) velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
+    outcome.need_keyframe = need_keyframe(frame, inliers, mapping_idle);
+  } else {
+    state_ = TrackState::Lost;
+    frame.T_cam_world = T_predicted;  // best guess, reported with state Lost
+    clear_matches(frame);
+  }
+  outcome.state = state_;
+  outcome.inliers = inliers;
+  last_frame_ = frame;
+  last_frame_->grid = KeypointGrid();
+  return outcome;
+}
+
+bool Tracker::initialise(Frame& frame) {
+  const int usable = static_cast<int>(std::count_if(frame.depth_sigma.begin(), frame.depth_sigma.end(),
+                                                    [](float s) { return s > 0.0F; }));
+  if (usable < options_.min_initial_depth_points) return false;
+  frame.T_cam_world = Eigen::Isometry3d::Identity();
+  std::unique_lock lock(map_.mutex());
+  Keyframe kf;
+  kf.frame_index = frame.index;
+  kf.timestamp = frame.timestamp;
+  kf.T_cam_world = frame.T_cam_world;
+  kf.keypoints = frame.keypoints;
+  kf.descriptors = frame.descriptors;
+  kf.depth = frame.depth;
+  kf.depth_sigma = frame.depth_sigma;
+  const KeyframeId id = map_.add_keyframe(std::move(kf));
+  const Eigen::Isometry3d T_world_cam = frame.T_cam_world.inverse();
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.depth_sigma[i] <= 0.0F) continue;
+    const Eigen::Vector3d p = camera_.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y),
+                                                frame.depth[i]);
+    const LandmarkId l = map_.add_landmark(T_world_cam * p, id);
+    map_.add_observation(l, id, static_cast<int>(i));
+    map_.update_landmark(l);
+    frame.landmarks[i] = l;
+  }
+  reference_ = id;
+  last_keyframe_frame_ = frame.index;
+  local_keyframes_ = {id};
+  return true;
+}
+
+int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra) {
+  std::vector<PoseObservation> observations;
+  std::vector<std::size_t> keypoint_of;
+  observations.reserve(frame.size());
+  {
+    std::shared_lock lock(map_.mutex());
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      const Landmark* l = frame.landmarks[i].valid() ? map_.landmark(frame.landmarks[i]) : nullptr;
+      if (l == nullptr) {
+        frame.landmarks[i] = LandmarkId{};
+        continue;
+      }
+      PoseObservation o;
+      o.p_world = l->position;
+      o.pixel = Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y);
+      o.sigma_px = level_scale(map_, frame.keypoints[i].level);
+      if (frame.depth_sigma[i] > 0.0F && frame.depth[i] < options_.close_depth) {
+        o.depth = frame.depth[i];
+        o.depth_sigma = frame.depth_sigma[i];
+      }
+      observations.push_back(o);
+      keypoint_of.push_back(i);
+    }
+  }
+  for (const auto& [i, p_world] : extra) {
+    PoseObservation o;
+    o.p_world = p_world;
+    o.pixel = Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y);
+    o.sigma_px = level_scale(map_, frame.keypoints[i].level);
+    if (frame.depth_sigma[i] > 0.0F && frame.depth[i] < options_.close_depth) {
+      o.depth = frame.depth[i];
+      o.depth_sigma = frame.depth_sigma[i];
+    }
+    observations.push_back(o);
+    keypoint_of.push_back(i);
+  }
+  if (observations.size() < static_cast<std::size_t>(options_.min_pose_inliers)) return 0;
+  const PoseOptimizerResult result = optimize_pose(camera_, frame.T_cam_world, observations, options_.pose);
+  frame.T_cam_world = result.T_cam_world;
+  for (std::size_t j = 0; j < observations.size(); ++j) frame.outlier[keypoint_of[j]] = !result.inlier[j];
+  return result.inliers;
+}
+
+namespace {
+
+// Frame-to-frame motion from depth on both sides, independent of any prediction: brute-force matching
+// (ratio test) between keypoints with depth, then a 3-point RANSAC on the rigid 3-D alignment. Breaks
+// the feedback of the constant-velocity prediction on periodic or weak texture (fences, grass), where
+// guided matching around a slightly wrong prediction finds matches that confirm it.
+std::optional<Eigen::Isometry3d> depth_motion_ransac(const PinholeCamera& camera, const Frame& last, const Frame& frame,
+                                                     const TrackerOptions& options) {
+  std::vector<Descriptor> last_desc, cur_desc;
+  std::vector<Eigen::Vector3d> last_pts, cur_pts;
+  for (std::size_t i = 0; i < last.size(); ++i) {
+    if (last.depth_sigma[i] <= 0.0F) continue;
+    last_desc.push_back(last.descriptors[i]);
+    last_pts.push_back(camera.unproject(Eigen::Vector2d(last.keypoints[i].x, last.keypoints[i].y), last.depth[i]));
+  }
+  // A strided subset of the current keypoints is enough for a 6-DoF consensus and bounds the cost.
+  std::size_t with_depth = 0;
+  for (std::size_t i = 0; i < frame.size(); ++i) with_depth += frame.depth_sigma[i] > 0.0F ? 1 : 0;
+  const std::size_t stride = std::max<std::size_t>(1, (with_depth + options.ransac_max_points - 1) /
+                                                          std::max<std::size_t>(1, options.ransac_max_points));
+  std::size_t seen = 0;
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.depth_sigma[i] <= 0.0F) continue;
+    if (seen++ % stride != 0) continue;
+    cur_desc.push_back(frame.descriptors[i]);
+    cur_pts.push_back(camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y), frame.depth[i]));
+  }
+  const auto matches = detail::match_brute_force(cur_desc, last_desc, options.ransac_max_hamming, options.ransac_ratio);
+  const int n = static_cast<int>(matches.size());
+  if (n < options.ransac_min_inliers) return std::nullopt;
+  auto fit = [&](const std::vector<int>& idx) {
+    Eigen::Matrix3Xd a(3, static_cast<Eigen::Index>(idx.size())), b(3, static_cast<Eigen::Index>(idx.size()));
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      const auto& [q, t] = matches[static_cast<std::size_t>(idx[k])];
+      a.col(static_cast<Eigen::Index>(k)) = last_pts[static_cast<std::size_t>(t)];
+      b.col(static_cast<Eigen::Index>(k)) = cur_pts[static_cast<std::size_t>(q)];
+    }
+    Eigen::Isometry3d T;
+    T.matrix() = Eigen::umeyama(a, b, false);
+    return T;
+  };
+  auto inliers_of = [&](const Eigen::Isometry3d& T, std::vector<int>& out) {
+    out.clear();
+    for (int m = 0; m < n; ++m) {
+      const auto& [q, t] = matches[static_cast<std::size_t>(m)];
+      const Eigen::Vector3d& pc = cur_pts[static_cast<std::size_t>(q)];
+      const double tolerance = std::max(options.ransac_min_tolerance, options.ransac_relative_tolerance * pc.z());
+      if ((T * last_pts[static_cast<std::size_t>(t)] - pc).norm() < tolerance) out.push_back(m);
+    }
+  };
+  std::mt19937 rng(7);  // fixed seed: deterministic
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  std::vector<int> best, current;
+  for (int it = 0; it < options.ransac_iterations; ++it) {
+    std::vector<int> sample = {pick(rng), pick(rng), pick(rng)};
+    if (sample[0] == sample[1] || sample[1] == sample[2] || sample[0] == sample[2]) continue;
+    inliers_of(fit(sample), current);
+    if (current.size() > best.size()) best.swap(current);
+  }
+  if (static_cast<int>(best.size()) < options.ransac_min_inliers) return std::nullopt;
+  Eigen::Isometry3d T = fit(best);
+  inliers_of(T, best);
+  if (static_cast<int>(best.size()) < options.ransac_min_inliers) return std::nullopt;
+  return fit(best);
+}
+
+}  // namespace
+
+bool Tracker::track_with_motion_model(Frame& frame) {
+  frame.T_cam_world = *velocity_ * last_frame_->T_cam_world;
+  if (options_.ransac_prediction) {
+    if (const auto T_cur_last = depth_motion_ransac(camera_, *last_frame_, frame, options_)) {
+      frame.T_cam_world = *T_cur_last * last_frame_->T_cam_world;
+    }
+  }
+  std::vector<detail::ProjectedLandmark> candidates;
+  std::vector<Eigen::Vector3d> candidate_points;
+  const Eigen::Isometry3d T_world_last = last_frame_->T_cam_world.inverse();
+  auto build = [&](double radius_factor) {
+    candidates.clear();
+    candidate_points.clear();
+    std::shared_lock lock(map_.mutex());
+    const Frame& last = *last_frame_;
+    for (std::size_t i = 0; i < last.size(); ++i) {
+      const bool landmark = last.landmarks[i].valid() && !last.outlier[i];
+      const Landmark* l = landmark ? map_.landmark(last.landmarks[i]) : nullptr;
+      // Keypoints of the last frame with depth but no landmark become temporary points (ORB-SLAM's
+      // visual-odometry points): they anchor frame-to-frame motion where the map is thin.
+      const bool temporary = l == nullptr && last.depth_sigma[i] > 0.0F && options_.temporary_points;
+      if (l == nullptr && !temporary) continue;
+      const Eigen::Vector3d p_world =
+          l != nullptr ? l->position
+                       : T_world_last * camera_.unproject(Eigen::Vector2d(last.keypoints[i].x, last.keypoints[i].y),
+                                                          last.depth[i]);
+      const Eigen::Vector3d p = frame.T_cam_world * p_world;
+      if (p.z() <= 0.0) continue;
+      const Eigen::Vector2d px = camera_.project_unchecked(p);
+      if (!camera_.in_image(px)) continue;
+      const int level = last.keypoints[i].level;
+      detail::ProjectedLandmark c;
+      if (l != nullptr) c.id = l->id;
+      c.descriptor = l != nullptr ? &l->descriptor : &last.descriptors[i];
+      c.x = static_cast<float>(px.x());
+      c.y = static_cast<float>(px.y());
+      c.radius = static_cast<float>(radius_factor * level_scale(map_, level));
+      candidate_points.push_back(p_world);
+      c.min_level = std::max(0, level - 1);
+      c.max_level = level + 1;
+      c.angle = last.keypoints[i].angle;
+      c.depth = static_cast<float>(p.z());
+      candidates.push_back(c);
+    }
+  };
+  std::vector<int> candidate_of_keypoint;
+  const detail::DepthGate gate{static_cast<float>(options_.depth_gate_sigmas),
+                               static_cast<float>(options_.depth_gate_min_motion)};
+  build(options_.motion_radius);
+  int matches = detail::match_projected(frame, candidates, options_.motion_max_hamming, options_.motion_ratio, options_.check_orientation,
+                                        &candidate_of_keypoint, gate);
+  if (matches < options_.motion_min_matches) {
+    clear_matches(frame);
+    build(2.0 * options_.motion_radius);
+    matches = detail::match_projected(frame, candidates, options_.motion_max_hamming, options_.motion_ratio, options_.check_orientation,
+                                      &candidate_of_keypoint, gate);
+  }
+  if (matches < options_.motion_min_matches) return false;
+  std::vector<std::pair<std::size_t, Eigen::Vector3d>> extra;
+  for (std::size_t k = 0; k < frame.size(); ++k) {
+    const int c = candidate_of_keypoint[k];
+    if (c >= 0 && !candidates[static_cast<std::size_t>(c)].id.valid()) {
+      extra.emplace_back(k, candidate_points[static_cast<std::size_t>(c)]);
+    }
+  }
+  const int inliers = optimise_pose(frame, extra);
+  discard_outliers(frame);
+  return inliers >= options_.min_pose_inliers;
+}
+
+bool Tracker::track_reference_keyframe(Frame& frame) {
+  std::vector<Descriptor> train;
+  std::vector<LandmarkId> train_landmarks;
+  {
+    std::shared_lock lock(map_.mutex());
+    const Keyframe* kf = map_.keyframe(reference_);
+    if (kf == nullptr) kf = map_.keyframe(map_.last_keyframe_id());
+    if (kf == nullptr) return false;
+    for (std::size_t i = 0; i < kf->keypoints.size(); ++i) {
+      if (!kf->landmarks[i].valid()) continue;
+      train.push_back(kf->descriptors[i]);
+      train_landmarks.push_back(kf->landmarks[i]);
+    }
+  }
+  const auto matches =
+      detail::match_brute_force(frame.descriptors, train, options_.max_hamming, options_.reference_ratio);
+  if (static_cast<int>(matches.size()) < 15) return false;
+  for (const auto& [q, t] : matches) frame.landmarks[static_cast<std::size_t>(q)] = train_landmarks[static_cast<std::size_t>(t)];
+  frame.T_cam_world = last_frame_ ? last_frame_->T_cam_world : Eigen::Isometry3d::Identity();
+  const int inliers = optimise_pose(frame);
+  discard_outliers(frame);
+  return inliers >= options_.min_pose_inliers;
+}
+
+void Tracker::update_local_map(const Frame& frame) {
+  std::map<KeyframeId, int> votes;
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    const Landmark* l = frame.landmarks[i].valid() ? map_.landmark(frame.landmarks[i]) : nullptr;
+    if (l == nullptr) continue;
+    for (const auto& [kf, index] : l->observations) ++votes[kf];
+  }
+  std::vector<std::pair<int, KeyframeId>> sorted;
+  for (const auto& [kf, n] : votes) sorted.emplace_back(n, kf);
+  std::sort(sorted.begin(), sorted.end(),
+            [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second > b.second; });
+  local_keyframes_.clear();
+  std::vector<KeyframeId> added;
+  auto push = [&](KeyframeId id) {
+    if (std::find(local_keyframes_.begin(), local_keyframes_.end(), id) != local_keyframes_.end()) return;
+    local_keyframes_.push_back(id);
+  };
+  for (const auto& [n, kf] : sorted) {
+    if (static_cast<int>(local_keyframes_.size()) >= options_.max_local_keyframes) break;
+    push(kf);
+  }
+  const std::size_t direct = local_keyframes_.size();
+  for (std::size_t i = 0; i < direct && static_cast<int>(local_keyframes_.size()) < options_.max_local_keyframes; ++i) {
+    for (const KeyframeId n : map_.best_covisible(local_keyframes_[i], 10)) {
+      if (static_cast<int>(local_keyframes_.size()) >= options_.max_local_keyframes) break;
+      push(n);
+    }
+  }
+  if (!sorted.empty()) reference_ = sorted.front().second;
+  local_landmarks_.clear();
+  for (const KeyframeId id : local_keyframes_) {
+    const Keyframe* kf = map_.keyframe(id);
+    if (kf == nullptr) continue;
+    for (const LandmarkId l : kf->landmarks) {
+      if (l.valid()) local_landmarks_.push_back(l);
+    }
+  }
+  std::sort(local_landmarks_.begin(), local_landmarks_.end());
+  local_landmarks_.erase(std::unique(local_landmarks_.begin(), local_landmarks_.end()), local_landmarks_.end());
+}
+
+bool Tracker::track_local_map(Frame& frame) {
+  std::vector<detail::ProjectedLandmark> candidates;
+  std::vector<LandmarkId> visible;
+  {
+    std::shared_lock lock(map_.mutex());
+    update_local_map(frame);
+    std::vector<LandmarkId> matched;
+    for (const LandmarkId l : frame.landmarks) {
+      if (l.valid()) matched.push_back(l);
+    }
+    std::sort(matched.begin(), matched.end());
+    const Eigen::Isometry3d T_world_cam = frame.T_cam_world.inverse();
+    const Eigen::Vector3d center = T_world_cam.translation();
+    const int levels = map_.options().levels;
+    const double scale = map_.options().scale_factor;
+    for (const LandmarkId id : local_landmarks_) {
+      if (std::binary_search(matched.begin(), matched.end(), id)) continue;
+      const Landmark* l = map_.landmark(id);
+      if (l == nullptr) continue;
+      const Eigen::Vector3d p = frame.T_cam_world * l->position;
+      if (p.z() <= 0.0) continue;
+      const Eigen::Vector2d px = camera_.project_unchecked(p);
+      if (!camera_.in_image(px)) continue;
+      const Eigen::Vector3d ray = l->position - center;
+      const double distance = ray.norm();
+      if (distance < 0.8 * l->min_distance || distance > 1.2 * l->max_distance) continue;
+      if (ray.dot(l->normal) < options_.min_view_cos * distance) continue;
+      const int level = l->predict_level(distance, levels, scale);
+      visible.push_back(id);
+      detail::ProjectedLandmark c;
+      c.id = id;
+      c.descriptor = &l->descriptor;
+      c.x = static_cast<float>(px.x());
+      c.y = static_cast<float>(px.y());
+      c.radius = static_cast<float>(options_.local_map_radius * std::pow(scale, level));
+      c.min_level = std::max(0, level - 1);
+      c.max_level = level;
+      c.depth = static_cast<float>(p.z());
+      candidates.push_back(c);
+    }
+    const detail::DepthGate gate{static_cast<float>(options_.depth_gate_sigmas),
+                                 static_cast<float>(options_.depth_gate_min_local_map)};
+    detail::match_projected(frame, candidates, options_.max_hamming, options_.local_map_ratio, false, nullptr, gate);
+  }
+  const int inliers = optimise_pose(frame);
+  {
+    std::unique_lock lock(map_.mutex());
+    for (const LandmarkId id : visible) {
+      if (Landmark* l = map_.landmark(id)) ++l->visible;
+    }
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      if (!frame.landmarks[i].valid()) continue;
+      if (frame.outlier[i]) continue;
+      if (Landmark* l = map_.landmark(frame.landmarks[i])) ++l->found;
+    }
+  }
+  discard_outliers(frame);
+  const bool recently_relocalised =
+      last_relocalisation_frame_ > 0 && frame.index < last_relocalisation_frame_ + 
+      static_cast<std::size_t>(options_.max_frames_between_keyframes);
+  return inliers >= (recently_relocalised ? options_.relocalisation_min_inliers : options_.min_local_map_inliers);
+}
+
+bool Tracker::relocalise(Frame& frame) {
+  std::vector<Descriptor> train;
+  std::vector<LandmarkId> ids;
+  std::vector<Eigen::Vector3d> positions;
+  {
+    std::shared_lock lock(map_.mutex());
+    for (const LandmarkId id : map_.landmark_ids()) {
+      const Landmark* l = map_.landmark(id);
+      train.push_back(l->descriptor);
+      ids.push_back(id);
+      positions.push_back(l->position);
+    }
+  }
+  const auto matches = detail::match_brute_force(frame.descriptors, train, options_.max_hamming, 0.75);
+  if (static_cast<int>(matches.size()) < options_.relocalisation_min_inliers) return false;
+  std::vector<cv::Point3f> object;
+  std::vector<cv::Point2f> image;
+  for (const auto& [q, t] : matches) {
+    const Eigen::Vector3d& p = positions[static_cast<std::size_t>(t)];
+    object.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+    image.emplace_back(frame.keypoints[static_cast<std::size_t>(q)].x, frame.keypoints[static_cast<std::size_t>(q)].y);
+  }
+  cv::Mat K = (cv::Mat_<double>(3, 3) << camera_.fx, 0.0, camera_.cx, 0.0, camera_.fy, camera_.cy, 0.0, 0.0, 1.0);
+  cv::Mat rvec, tvec;
+  std::vector<int> inlier_indices;
+  cv::setRNGSeed(12345);  // deterministic RANSAC
+  if (!cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, false, 300, 4.0F, 0.99, inlier_indices,
+                          cv::SOLVEPNP_EPNP)) {
+    return false;
+  }
+  if (static_cast<int>(inlier_indices.size()) < options_.relocalisation_min_inliers) return false;
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  Eigen::Matrix3d Re;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) Re(r, c) = R.at<double>(r, c);
+  }
+  frame.T_cam_world = make_isometry(Re, Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)));
+  for (const int i : inlier_indices) {
+    const auto& [q, t] = matches[static_cast<std::size_t>(i)];
+    frame.landmarks[static_cast<std::size_t>(q)] = ids[static_cast<std::size_t>(t)];
+  }
+  const int inliers = optimise_pose(frame);
+  discard_outliers(frame);
+  if (inliers < options_.relocalisation_min_inliers) return false;
+  last_relocalisation_frame_ = frame.index;
+  return true;
+}
+
+bool Tracker::need_keyframe(const Frame& frame, int inliers, bool mapping_idle) const {
+  std::shared_lock lock(map_.mutex());
+  const int keyframes = static_cast<int>(map_.keyframe_count());
+  const auto since_last = static_cast<int>(frame.index - last_keyframe_frame_);
+  if (last_relocalisation_frame_ > 0 &&
+      frame.index < last_relocalisation_frame_ + static_cast<std::size_t>(options_.max_frames_between_keyframes) &&
+      keyframes > options_.max_frames_between_keyframes) {
+    return false;
+  }
+  const int min_observations = keyframes <= 2 ? 2 : 3;
+  const Keyframe* ref = map_.keyframe(reference_);
+  const int reference_matches = ref != nullptr ? ref->tracked_landmarks(min_observations, map_) : 0;
+  int tracked_close = 0, untracked_close = 0;
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.depth_sigma[i] <= 0.0F || frame.depth[i] >= options_.close_depth) continue;
+    if (frame.landmarks[i].valid() && !frame.outlier[i]) ++tracked_close;
+    else ++untracked_close;
+  }
+  const bool need_close =
+      tracked_close < options_.close_tracked_threshold && untracked_close > options_.close_untracked_threshold;
+  const double ratio = keyframes < 2 ? 0.4 : options_.reference_ratio_threshold;
+  const bool c1a = since_last >= options_.max_frames_between_keyframes;
+  const bool c1b = mapping_idle;
+  const bool c1c = inliers < 0.25 * reference_matches || need_close;
+  const bool c2 = (inliers < ratio * reference_matches || need_close) && inliers > options_.min_keyframe_inliers;
+  return (c1a || c1b || c1c) && c2;
+}
+
+KeyframeId Tracker::make_keyframe(const Frame& frame) {
+  std::unique_lock lock(map_.mutex());
+  Keyframe kf;
+  kf.frame_index = frame.index;
+  kf.timestamp = frame.timestamp;
+  kf.T_cam_world = frame.T_cam_world;
+  kf.keypoints = frame.keypoints;
+  kf.descriptors = frame.descriptors;
+  kf.depth = frame.depth;
+  kf.depth_sigma = frame.depth_sigma;
+  const KeyframeId id = map_.add_keyframe(std::move(kf));
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.landmarks[i].valid() && !frame.outlier[i]) map_.add_observation(frame.landmarks[i], id, static_cast<int>(i));
+  }
+  reference_ = id;
+  last_keyframe_frame_ = frame.index;
+  return id;
+}
+
+}  // namespace rgbl

@@ -1,0 +1,123 @@
+#include "rgbl/backend/bundle_adjustment.hpp"
+#include "rgbl/backend/depth_noise.hpp"
+#include "rgbl/backend/pose_optimizer.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <random>
+
+namespace {
+
+rgbl::PinholeCamera kitti_camera() {
+  rgbl::PinholeCamera c;
+  c.fx = c.fy = 707.0912;
+  c.cx = 601.8873;
+  c.cy = 183.1104;
+  c.width = 1226;
+  c.height = 370;
+  return c;
+}
+
+// Points in front of the camera at T_cam_world, 5..40 m deep, spread over the image.
+std::vector<Eigen::Vector3d> scene(std::mt19937& rng, const Eigen::Isometry3d& T_cam_world, int n) {
+  const rgbl::PinholeCamera cam = kitti_camera();
+  std::uniform_real_distribution<double> u(0.0, cam.width - 1.0), v(0.0, cam.height - 1.0), z(5.0, 40.0);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < n; ++i) {
+    points.push_back(T_cam_world.inverse() * cam.unproject(Eigen::Vector2d(u(rng), v(rng)), z(rng)));
+  }
+  return points;
+}
+
+Eigen::Isometry3d test_pose() {
+  rgbl::Vector6d xi;
+  xi << 0.3, -0.1, 2.0, 0.02, -0.05, 0.01;
+  return rgbl::se3_exp(xi);
+}
+
+}  // namespace
+
+TEST_CASE("pose residual Jacobian matches numeric differentiation") {
+  const auto cam = kitti_camera();
+  const Eigen::Isometry3d T = test_pose();
+  std::mt19937 rng(1);
+  const auto points = scene(rng, T, 20);
+  for (const bool with_depth : {false, true}) {
+    for (const auto& p : points) {
+      rgbl::PoseObservation o;
+      o.p_world = p;
+      o.pixel = cam.project_unchecked(T * p) + Eigen::Vector2d(1.5, -0.7);
+      o.sigma_px = 1.44;
+      if (with_depth) {
+        o.depth = (T * p).z() + 0.3;
+        o.depth_sigma = 0.2;
+      }
+      Eigen::Vector3d r0, r1;
+      Eigen::Matrix<double, 3, 6> J, unused;
+      int dim = 0;
+      REQUIRE(rgbl::pose_residual(cam, T, o, r0, J, dim));
+      CHECK(dim == (with_depth ? 3 : 2));
+      const double h = 1e-6;
+      Eigen::Matrix<double, 3, 6> numeric;
+      for (int k = 0; k < 6; ++k) {
+        rgbl::Vector6d d = rgbl::Vector6d::Zero();
+        d(k) = h;
+        Eigen::Vector3d rp, rm;
+        rgbl::pose_residual(cam, rgbl::se3_exp(d) * T, o, rp, unused, dim);
+        rgbl::pose_residual(cam, rgbl::se3_exp(-d) * T, o, rm, unused, dim);
+        numeric.col(k) = (rp - rm) / (2.0 * h);
+      }
+      CHECK((numeric - J).norm() < 1e-4 * (1.0 + J.norm()));
+    }
+  }
+}
+
+TEST_CASE("pose optimisation recovers a known pose with noise and flags the outliers") {
+  const auto cam = kitti_camera();
+  const Eigen::Isometry3d T_true = test_pose();
+  std::mt19937 rng(2);
+  const auto points = scene(rng, T_true, 300);
+  std::normal_distribution<double> px_noise(0.0, 1.0), z_noise(0.0, 0.05);
+  std::uniform_real_distribution<double> wild(-60.0, 60.0);
+  std::vector<rgbl::PoseObservation> obs;
+  std::vector<bool> is_outlier;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    rgbl::PoseObservation o;
+    o.p_world = points[i];
+    const Eigen::Vector3d pc = T_true * points[i];
+    o.pixel = cam.project_unchecked(pc) + Eigen::Vector2d(px_noise(rng), px_noise(rng));
+    if (i % 2 == 0) {
+      o.depth = pc.z() + z_noise(rng);
+      o.depth_sigma = 0.05;
+    }
+    const bool outlier = i % 5 == 0;  // 20% gross outliers
+    if (outlier) o.pixel += Eigen::Vector2d(wild(rng) > 0 ? 25.0 : -25.0, wild(rng));
+    obs.push_back(o);
+    is_outlier.push_back(outlier);
+  }
+  rgbl::Vector6d offset;
+  offset << 0.5, -0.3, 1.2, 0.03, 0.02, -0.02;  // 1.3 m and ~2 degrees off
+  const auto result = rgbl::optimize_pose(cam, rgbl::se3_exp(offset) * T_true, obs);
+  const Eigen::Isometry3d E = result.T_cam_world * T_true.inverse();
+  CHECK(E.translation().norm() < 0.02);
+  CHECK(rgbl::rotation_angle(E.linear()) < 1e-3);
+  int flagged = 0, wrong = 0;
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    if (is_outlier[i] && !result.inlier[i]) ++flagged;
+    if (!is_outlier[i] && !result.inlier[i]) ++wrong;
+  }
+  CHECK(flagged == 60);
+  CHECK(wrong < 24);  // chi2 at 95%: ~5% of the good ones fall outside
+  CHECK(result.inliers == static_cast<int>(obs.size()) - flagged - wrong);
+}
+
+TEST_CASE("depth noise model grows with depth and sample distance and rejects edges") {
+  const rgbl::DepthNoiseModel m;
+  const double fx = 707.0;
+  CHECK(m.sigma(10.0, 0.0, 0.0, fx) > 0.0);
+  CHECK(m.sigma(20.0, 0.0, 0.0, fx) > m.sigma(10.0, 0.0, 0.0, fx));
+  CHECK(m.sigma(10.0, 2.0, 0.0, fx) > m.sigma(10.0, 0.0, 0.0, fx));
+  CHECK(m.sigma(10.0, 0.0, 5.0, fx) == 0.0);   // foreground/background edge
+  CHECK(m.sigma(0.0, 0.0, 0.0, fx) == 0.0);
+  CHECK(m.sigma(10.0, 0.0, 0.0, fx) == Approx(std::sqrt(0.03 * 0.03 + 0.05 * 0.05)));
+}

@@ -1,0 +1,154 @@
+#include "rgbl/backend/bundle_adjustment.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <random>
+
+namespace {
+
+rgbl::PinholeCamera camera() {
+  rgbl::PinholeCamera c;
+  c.fx = c.fy = 707.0912;
+  c.cx = 601.8873;
+  c.cy = 183.1104;
+  c.width = 1226;
+  c.height = 370;
+  return c;
+}
+
+Eigen::Isometry3d pose_along_road(double z) {
+  rgbl::Vector6d xi;
+  xi << 0.05 * z, 0.01 * z, -z, 0.002 * z, 0.004 * z, -0.001 * z;  // T_cam_world: camera at +z
+  return rgbl::se3_exp(xi);
+}
+
+}  // namespace
+
+TEST_CASE("bundle residual Jacobians match numeric differentiation") {
+  const auto cam = camera();
+  const Eigen::Isometry3d T = pose_along_road(3.0);
+  const Eigen::Vector3d p = T.inverse() * Eigen::Vector3d(2.0, -1.0, 15.0);
+  for (const bool with_depth : {false, true}) {
+    rgbl::BundleObservation o;
+    o.pixel = cam.project_unchecked(T * p) + Eigen::Vector2d(0.8, -1.1);
+    o.sigma_px = 1.2;
+    if (with_depth) {
+      o.depth = 15.2;
+      o.depth_sigma = 0.1;
+    }
+    Eigen::Vector3d r;
+    Eigen::Matrix<double, 3, 6> jp;
+    Eigen::Matrix3d jx;
+    const int dim = rgbl::bundle_residual(cam, T, p, o, r, jp, jx);
+    CHECK(dim == (with_depth ? 3 : 2));
+    const rgbl::Vector6d x0 = rgbl::pose_to_parameters(T);
+    const double h = 1e-6;
+    Eigen::Matrix<double, 3, 6> np;
+    Eigen::Matrix3d nx;
+    Eigen::Matrix<double, 3, 6> unused_p;
+    Eigen::Matrix3d unused_x;
+    for (int k = 0; k < 6; ++k) {
+      rgbl::Vector6d d = rgbl::Vector6d::Zero();
+      d(k) = h;
+      Eigen::Vector3d rp, rm;
+      rgbl::bundle_residual(cam, rgbl::parameters_to_pose(x0 + d), p, o, rp, unused_p, unused_x);
+      rgbl::bundle_residual(cam, rgbl::parameters_to_pose(x0 - d), p, o, rm, unused_p, unused_x);
+      np.col(k) = (rp - rm) / (2.0 * h);
+    }
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector3d d = Eigen::Vector3d::Zero();
+      d(k) = h;
+      Eigen::Vector3d rp, rm;
+      rgbl::bundle_residual(cam, T, p + d, o, rp, unused_p, unused_x);
+      rgbl::bundle_residual(cam, T, p - d, o, rm, unused_p, unused_x);
+      nx.col(k) = (rp - rm) / (2.0 * h);
+    }
+    CHECK((np - jp).norm() < 1e-4 * (1.0 + jp.norm()));
+    CHECK((nx - jx).norm() < 1e-4 * (1.0 + jx.norm()));
+    // The residual is the whitened reprojection (and depth) error.
+    CHECK(r(0) == Approx(-0.8 / 1.2));
+    if (with_depth) CHECK(r(2) == Approx((15.0 - 15.2) / 0.1));
+  }
+}
+
+TEST_CASE("local bundle adjustment recovers poses and points, keeps fixed poses, flags outliers") {
+  const auto cam = camera();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(20.0, cam.width - 20.0), v(20.0, cam.height - 20.0), z(6.0, 30.0);
+  std::normal_distribution<double> noise(0.0, 0.5), pose_noise(0.0, 0.05), point_noise(0.0, 0.2);
+  rgbl::BundleProblem truth;
+  for (int k = 0; k < 6; ++k) truth.poses.push_back({pose_along_road(1.5 * k), k < 2});
+  for (int i = 0; i < 300; ++i) {
+    truth.points.push_back(truth.poses[0].T_cam_world.inverse() *
+                           cam.unproject(Eigen::Vector2d(u(rng), v(rng)), z(rng) + 9.0));
+  }
+  rgbl::BundleProblem problem = truth;
+  std::vector<bool> is_outlier;
+  for (int k = 0; k < 6; ++k) {
+    for (int i = 0; i < 300; ++i) {
+      const Eigen::Vector3d pc = truth.poses[static_cast<std::size_t>(k)].T_cam_world * truth.points[static_cast<std::size_t>(i)];
+      const auto px = cam.project(pc);
+      if (!px) continue;
+      rgbl::BundleObservation o;
+      o.pose = k;
+      o.point = i;
+      o.pixel = *px + Eigen::Vector2d(noise(rng), noise(rng));
+      if (i % 3 == 0) {
+        o.depth = pc.z() + 0.3 * noise(rng) * 0.1;
+        o.depth_sigma = 0.05;
+      }
+      const bool outlier = (i * 7 + k) % 37 == 0;
+      if (outlier) o.pixel += Eigen::Vector2d(30.0, -20.0);
+      problem.observations.push_back(o);
+      is_outlier.push_back(outlier);
+    }
+  }
+  for (std::size_t k = 2; k < problem.poses.size(); ++k) {
+    rgbl::Vector6d d;
+    d << pose_noise(rng), pose_noise(rng), pose_noise(rng), 0.1 * pose_noise(rng), 0.1 * pose_noise(rng), 0.0;
+    problem.poses[k].T_cam_world = rgbl::se3_exp(d) * problem.poses[k].T_cam_world;
+  }
+  for (auto& p : problem.points) p += Eigen::Vector3d(point_noise(rng), point_noise(rng), point_noise(rng));
+  rgbl::BundleAdjustmentOptions options;
+  options.iterations = 20;
+  const auto result = rgbl::bundle_adjust(cam, problem, options);
+  CHECK_FALSE(result.aborted);
+  CHECK(result.final_cost < result.initial_cost);
+  for (std::size_t k = 0; k < 2; ++k) {
+    CHECK((problem.poses[k].T_cam_world.matrix() - truth.poses[k].T_cam_world.matrix()).norm() == 0.0);
+  }
+  for (std::size_t k = 2; k < problem.poses.size(); ++k) {
+    const Eigen::Isometry3d E = problem.poses[k].T_cam_world * truth.poses[k].T_cam_world.inverse();
+    CHECK(E.translation().norm() < 0.02);
+    CHECK(rgbl::rotation_angle(E.linear()) < 1e-3);
+  }
+  int flagged = 0, total = 0;
+  for (std::size_t i = 0; i < is_outlier.size(); ++i) {
+    if (!is_outlier[i]) continue;
+    ++total;
+    flagged += result.outlier[i] ? 1 : 0;
+  }
+  CHECK(total > 10);
+  CHECK(flagged == total);
+}
+
+TEST_CASE("bundle adjustment stops when the abort flag is set") {
+  const auto cam = camera();
+  rgbl::BundleProblem problem;
+  problem.poses = {{pose_along_road(0.0), true}, {pose_along_road(1.0), false}};
+  for (int i = 0; i < 50; ++i) {
+    const Eigen::Vector3d p(-5.0 + 0.2 * i, 1.0 - 0.05 * i, 12.0 + 0.3 * i);
+    problem.points.push_back(p);
+    for (int k = 0; k < 2; ++k) {
+      rgbl::BundleObservation o;
+      o.pose = k;
+      o.point = i;
+      o.pixel = cam.project_unchecked(problem.poses[static_cast<std::size_t>(k)].T_cam_world * p) + Eigen::Vector2d(3.0, 0.0);
+      problem.observations.push_back(o);
+    }
+  }
+  const std::atomic<bool> abort{true};
+  const auto result = rgbl::bundle_adjust(cam, problem, {}, &abort);
+  CHECK(result.aborted);
+  CHECK(result.iterations <= 2);
+}

@@ -1,0 +1,120 @@
+#include "apps/dev/kitti_run.hpp"
+#include "rgbl/core/error.hpp"
+#include "rgbl/tracking/frame.hpp"
+#include "rgbl/tracking/system.hpp"
+#include "support/data.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <random>
+
+namespace {
+
+// A depth source that never has depth: the tracker must stay "not initialised", never crash.
+class NoDepth final : public rgbl::DepthSource {
+ public:
+  std::string_view name() const override { return "none"; }
+  void prepare(const rgbl::SensorFrame&) override {}
+  void sample(std::span<const Eigen::Vector2f>, std::span<rgbl::KeypointDepth> out) const override {
+    for (auto& d : out) d = {};
+  }
+  cv::Mat_<float> dense_depth() const override { return {}; }
+};
+
+rgbl::CameraCalibration small_camera() {
+  rgbl::CameraCalibration c;
+  c.camera.fx = c.camera.fy = 300.0;
+  c.camera.cx = 160.0;
+  c.camera.cy = 120.0;
+  c.camera.width = 320;
+  c.camera.height = 240;
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("keypoint grid returns exactly the keypoints inside the window and level range") {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> x(0.0F, 639.0F), y(0.0F, 479.0F);
+  std::vector<rgbl::Keypoint> kps(2000);
+  for (std::size_t i = 0; i < kps.size(); ++i) {
+    kps[i].x = x(rng);
+    kps[i].y = y(rng);
+    kps[i].level = static_cast<int>(i % 8);
+  }
+  const rgbl::KeypointGrid grid(kps, 640, 480);
+  std::vector<int> out;
+  for (int q = 0; q < 200; ++q) {
+    const float qx = x(rng), qy = y(rng), r = 3.0F + static_cast<float>(q % 40);
+    const int min_level = q % 3, max_level = q % 5 == 0 ? -1 : min_level + 2;
+    grid.query(qx, qy, r, min_level, max_level, out);
+    std::vector<int> expected;
+    for (std::size_t i = 0; i < kps.size(); ++i) {
+      if (std::abs(kps[i].x - qx) <= r && std::abs(kps[i].y - qy) <= r && kps[i].level >= min_level &&
+          (max_level < 0 || kps[i].level <= max_level)) {
+        expected.push_back(static_cast<int>(i));
+      }
+    }
+    std::sort(out.begin(), out.end());
+    CHECK(out == expected);
+  }
+}
+
+TEST_CASE("system: configuration errors name the key; no depth keeps it uninitialised") {
+  auto extractor = [](const cv::Mat&, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
+    k.clear();
+    d.clear();
+  };
+  CHECK_THROWS_AS(rgbl::System({}, small_camera(), nullptr, extractor), rgbl::ConfigError);
+  rgbl::SystemOptions bad;
+  bad.tracker.max_hamming = 0;
+  CHECK_THROWS_AS(rgbl::System(bad, small_camera(), std::make_unique<NoDepth>(), extractor), rgbl::ConfigError);
+
+  rgbl::OrbExtractor orb;
+  rgbl::System system({}, small_camera(), std::make_unique<NoDepth>(),
+                      [&orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
+                        orb.extract(g, k, d);
+                      });
+  cv::Mat image(240, 320, CV_8UC1);
+  cv::randu(image, 0, 255);
+  for (std::size_t i = 0; i < 3; ++i) {
+    rgbl::SensorFrame frame;
+    frame.index = i;
+    frame.image = i == 1 ? cv::Mat(240, 320, CV_8UC1, cv::Scalar(0)) : image;  // a black frame too
+    const auto r = system.track(frame);
+    CHECK(r.state == rgbl::TrackState::NotInitialised);
+    CHECK(r.keypoints_with_depth == 0);
+  }
+  CHECK(system.trajectory().size() == 3);
+  CHECK(system.map().keyframe_count() == 0);
+}
+
+TEST_CASE("seq 04 with LiDAR depth: every frame tracked, ATE <= 0.10 m, drift <= 0.8 %") {
+  const auto sequence = rgbl::test::kitti_seq04();
+  if (!sequence) return;
+  rgbl::dev::RunOptions options;
+  options.camera = 2;
+  const auto s = rgbl::dev::run_kitti_sequence(*sequence, options);
+  INFO("ATE " << s.ate_rmse << " m, drift " << s.drift_percent << " %, scale " << s.scale_ratio);
+  CHECK(s.frames == 51);
+  CHECK(s.tracked == 51);
+  CHECK(s.ate_rmse <= 0.10);
+  CHECK(s.drift_percent <= 0.8);
+}
+
+TEST_CASE("deterministic mode: the same input gives a bit-identical trajectory") {
+  const auto sequence = rgbl::test::kitti_seq04();
+  if (!sequence) return;
+  rgbl::dev::RunOptions options;
+  options.camera = 0;
+  options.frames = 20;
+  const auto a = rgbl::dev::run_kitti_sequence(*sequence, options);
+  const auto b = rgbl::dev::run_kitti_sequence(*sequence, options);
+  REQUIRE(a.estimate.size() == 20);
+  REQUIRE(b.estimate.size() == 20);
+  for (std::size_t i = 0; i < a.estimate.size(); ++i) {
+    CHECK(a.estimate[i].matrix() == b.estimate[i].matrix());
+  }
+  CHECK(a.tracked == 20);
+  CHECK(a.ate_rmse < 0.1);
+}
