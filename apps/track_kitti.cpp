@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   app.add_option("sequence", sequence, "KITTI odometry sequence folder (.../sequences/NN)")->required();
   app.add_option("--camera", options.camera, "tracked camera (0 grey, 2 colour)")->check(CLI::IsMember({0, 2}));
   app.add_option("--frames", options.frames, "number of frames (default: all)");
+  app.add_option("--depth", options.depth, "depth source: lidar or stereo (needs image_<camera+1>)")
+      ->check(CLI::IsMember({"lidar", "stereo"}));
   app.add_option("--output", output, "write the cam0 trajectory in KITTI format");
   app.add_flag("--threaded", threaded, "local mapping in its own thread");
   app.add_flag("--verbose", options.verbose, "one line per frame");
@@ -59,9 +61,9 @@ int main(int argc, char** argv) {
     fmt::print("ATE RMSE {:.4f} m  end-point drift {:.3f} % of {:.2f} m  scale ratio {:.4f}\n", s.ate_rmse,
                s.drift_percent, s.path_length, s.scale_ratio);
     fmt::print("median ms: depth {:.2f}  extraction {:.2f}  tracking {:.2f}  mapping {:.2f}  "
-               "depth+extraction+tracking {:.2f}  total {:.2f} (mean total {:.2f})\n",
+               "depth+extraction+tracking {:.2f}  total {:.2f}; mean: mapping {:.2f}  total {:.2f}\n",
                s.median_depth_ms, s.median_extraction_ms, s.median_tracking_ms, s.median_mapping_ms,
-               s.median_front_ms, s.median_total_ms, s.mean_total_ms);
+               s.median_front_ms, s.median_total_ms, s.mean_mapping_ms, s.mean_total_ms);
     if (!output.empty()) rgbl::dev::write_kitti_trajectory(output, s.estimate);
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());

@@ -55,7 +55,7 @@ int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates,
         const float gap = std::max(gate.min_gap, gate.sigmas * frame.depth_sigma[static_cast<std::size_t>(k)]);
         if (std::abs(frame.depth[static_cast<std::size_t>(k)] - cand.depth) > gap) continue;
       }
-      const int d = distance(*cand.descriptor, frame.descriptors[static_cast<std::size_t>(k)]);
+      const int d = distance(cand.descriptor, frame.descriptors[static_cast<std::size_t>(k)]);
       if (d < best) {
         second = best;
         second_level = best_level;

@@ -16,7 +16,7 @@ int descriptor_distance(const Descriptor& a, const Descriptor& b) noexcept;
 
 struct ProjectedLandmark {
   LandmarkId id;
-  const Descriptor* descriptor = nullptr;
+  Descriptor descriptor{};  // a copy: the map may change once the lock is released
   float x = 0.0F, y = 0.0F;
   float radius = 0.0F;
   int min_level = 0, max_level = -1;

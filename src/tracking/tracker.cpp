@@ -67,8 +67,9 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   const Eigen::Isometry3d T_last = last_frame_ ? last_frame_->T_cam_world : Eigen::Isometry3d::Identity();
   const Eigen::Isometry3d T_predicted = velocity_ ? *velocity_ * T_last : T_last;
   bool ok = false;
+  bool motion_ok = false;
   if (state_ == TrackState::Ok) {
-    if (velocity_ && last_frame_) ok = track_with_motion_model(frame);
+    if (velocity_ && last_frame_) ok = motion_ok = track_with_motion_model(frame);
     if (!ok) {
       clear_matches(frame);
       ok = track_reference_keyframe(frame);
@@ -77,7 +78,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     // Recently lost: the frame-to-frame motion (depth RANSAC + temporary points) usually still holds
     // and keeps the trajectory continuous; otherwise relocalise against the whole map.
     if (velocity_ && last_frame_ && frame.index <= last_ok_frame_ + options_.recent_loss_frames) {
-      ok = track_with_motion_model(frame);
+      ok = motion_ok = track_with_motion_model(frame);
       if (!ok) clear_matches(frame);
     }
     if (!ok) {
@@ -86,8 +87,18 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     }
   }
   int inliers = 0;
+  bool weak = false;
   if (ok) {
+    const Frame after_motion = motion_ok ? frame : Frame{};
     ok = track_local_map(frame);
+    if (!ok && motion_ok && options_.keep_weak_tracking) {
+      // The map is thin here (e.g. mapping lags behind) but frame-to-frame motion held: keep the
+      // motion-model pose and refresh the map with a keyframe instead of declaring the camera lost.
+      frame = after_motion;
+      frame.build_grid(camera_.width, camera_.height);
+      ok = true;
+      weak = true;
+    }
     inliers = static_cast<int>(std::count_if(frame.landmarks.begin(), frame.landmarks.end(),
                                              [](LandmarkId l) { return l.valid(); }));
   }
@@ -95,7 +106,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     state_ = TrackState::Ok;
     last_ok_frame_ = frame.index;
     if (last_frame_) velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
-    outcome.need_keyframe = need_keyframe(frame, inliers, mapping_idle);
+    outcome.need_keyframe = weak || need_keyframe(frame, inliers, mapping_idle);
   } else {
     state_ = TrackState::Lost;
     frame.T_cam_world = T_predicted;  // best guess, reported with state Lost
@@ -283,7 +294,7 @@ bool Tracker::track_with_motion_model(Frame& frame) {
       const int level = last.keypoints[i].level;
       detail::ProjectedLandmark c;
       if (l != nullptr) c.id = l->id;
-      c.descriptor = l != nullptr ? &l->descriptor : &last.descriptors[i];
+      c.descriptor = l != nullptr ? l->descriptor : last.descriptors[i];
       c.x = static_cast<float>(px.x());
       c.y = static_cast<float>(px.y());
       c.radius = static_cast<float>(radius_factor * level_scale(map_, level));
@@ -416,7 +427,7 @@ bool Tracker::track_local_map(Frame& frame) {
       visible.push_back(id);
       detail::ProjectedLandmark c;
       c.id = id;
-      c.descriptor = &l->descriptor;
+      c.descriptor = l->descriptor;
       c.x = static_cast<float>(px.x());
       c.y = static_cast<float>(px.y());
       c.radius = static_cast<float>(options_.local_map_radius * std::pow(scale, level));

@@ -25,6 +25,7 @@ struct TrackerOptions {
   int min_pose_inliers = 10;            // pose optimisation success
   int min_local_map_inliers = 30;       // local-map tracking success
   int relocalisation_min_inliers = 50;
+  bool keep_weak_tracking = true;       // local map fails but the motion model held: keep going, add a keyframe
   std::size_t recent_loss_frames = 5;   // after a loss, try the motion model this long before relocalising
   bool check_orientation = true;        // rotation histogram consistency in guided matching
   // Depth gate in guided matching (0 sigmas = off): |measured - predicted z| <= max(min, sigmas * sigma).
