@@ -93,7 +93,7 @@ void add_input_options(CLI::App& app, InputOptions& options) {
       ->required();
   app.add_option("--format", options.format, "Dataset layout (auto detects it)")
       ->check(CLI::IsMember({"auto", "kitti", "kitti-raw", "tum"}));
-  app.add_option("--camera", options.camera, "Tracked camera: 0 (grey left) or 2 (colour left); default 2 if present")
+  app.add_option("--camera", options.camera, "Tracked camera: 0 (grey left, the default when present) or 2 (colour left)")
       ->check(CLI::IsMember({0, 2}));
   app.add_option("--depth", options.depth,
                  "Depth source: lidar (5x5 diamond), lidar:ipbasic, lidar:ipbasic-multiscale, lidar:diamond7, "
@@ -107,9 +107,10 @@ void add_input_options(CLI::App& app, InputOptions& options) {
 Pipeline make_pipeline(const InputOptions& options) {
   Pipeline p;
   p.sequence = open_sequence(options.dir, parse_dataset_format(options.format));
-  for (const auto& n : p.sequence->notes()) p.notes.push_back(n);
   const auto& sensors = p.sequence->sensors();
-  p.camera = options.camera >= 0 ? options.camera : (sensors.cameras[2] ? 2 : 0);
+  // The tracker works on grey images: a native grey camera (0) is the default, the colour camera (2)
+  // is converted per frame.
+  p.camera = options.camera >= 0 ? options.camera : (sensors.cameras[0] ? 0 : 2);
   if (!sensors.cameras[static_cast<std::size_t>(p.camera)]) {
     throw ConfigError("--camera", fmt::format("a camera the dataset has ({} has no camera {})",
                                               p.sequence->path().string(), p.camera));
