@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "Only print warnings and errors from the library");
 
   const std::vector<rgbl::cli::Command> commands{
+      rgbl::cli::add_run_command(app),
       rgbl::cli::add_info_command(app),
       rgbl::cli::add_eval_command(app),
   };

@@ -1,0 +1,315 @@
+// rgbl run <dir> [input options] [--out <dir>] [--threaded]
+#include "command.hpp"
+#include "pipeline.hpp"
+#include "run.hpp"
+
+#include "rgbl/core/error.hpp"
+#include "rgbl/core/timer.hpp"
+#include "rgbl/eval/trajectory_metrics.hpp"
+#include "rgbl/io/ply.hpp"
+#include "rgbl/io/read_ahead.hpp"
+#include "rgbl/io/svg_plot.hpp"
+#include "rgbl/io/trajectory_io.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <vector>
+
+namespace rgbl::cli {
+namespace {
+
+struct StageStats {
+  double median = 0.0, p95 = 0.0, mean = 0.0, max = 0.0;
+};
+
+StageStats stats(std::vector<double> v) {
+  StageStats s;
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  const auto at = [&](double q) { return v[static_cast<std::size_t>(std::min<double>(v.size() - 1, std::floor(q * (v.size() - 1) + 0.5)))]; };
+  s.median = at(0.5);
+  s.p95 = at(0.95);
+  double sum = 0.0;
+  for (const double x : v) sum += x;
+  s.mean = sum / static_cast<double>(v.size());
+  s.max = v.back();
+  return s;
+}
+
+std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "null"; }
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<int>(c));
+      continue;
+    }
+    out += c;
+  }
+  return out + "\"";
+}
+
+// Short runs get shorter KITTI segment lengths (SPEC 6): 8 steps of a round length below the path.
+KittiMetricOptions kitti_lengths_for(double path_length, std::string& description) {
+  KittiMetricOptions options;
+  if (path_length >= 800.0) {
+    description = "100..800 m";
+    return options;
+  }
+  const double step = std::max(1.0, std::ceil(path_length / 80.0)) * 10.0;
+  options.lengths.clear();
+  for (double l = step; l < path_length && options.lengths.size() < 8; l += step) options.lengths.push_back(l);
+  if (options.lengths.empty()) options.lengths.push_back(std::max(1.0, std::floor(path_length / 2.0)));
+  description = fmt::format("{:g}..{:g} m (short run)", options.lengths.front(), options.lengths.back());
+  return options;
+}
+
+struct FrameRecord {
+  TrackResult result;
+  double io_wait_ms = 0.0;
+};
+
+}  // namespace
+
+RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool threaded, bool quiet) {
+  std::filesystem::create_directories(out_dir);
+  SystemOptions system_options = p.system;
+  system_options.threaded_mapping = threaded;
+  System system(system_options, p.calibration, p.make_depth_source(), p.make_extractor());
+
+  ReadAheadOptions read_options;
+  read_options.first = p.first;
+  read_options.count = p.count;
+  ReadAhead frames(*p.sequence, read_options);
+  const bool tty = ::isatty(STDERR_FILENO) != 0;
+  std::vector<FrameRecord> records;
+  records.reserve(p.count);
+  Stopwatch wall;
+  Stopwatch progress_clock;
+  for (;;) {
+    Stopwatch wait;
+    std::optional<FrameInput> input = frames.next();
+    const double wait_ms = wait.elapsed_ms();
+    if (!input) break;
+    FrameRecord record;
+    record.result = system.track(sensor_frame(*input, p.camera));
+    record.io_wait_ms = wait_ms;
+    records.push_back(record);
+    if (!quiet && (progress_clock.elapsed_ms() > 1000.0 || records.size() == p.count)) {
+      progress_clock.restart();
+      const auto& r = record.result;
+      const std::string line = fmt::format("frame {}/{}  {}  {:.1f} ms  {:.1f} frames/s", records.size(), p.count,
+                                           to_string(r.state), r.timing.total_ms,
+                                           static_cast<double>(records.size()) / (wall.elapsed_ms() / 1000.0));
+      if (tty) {
+        fmt::print(stderr, "\r{:<70}", line);
+      } else {
+        fmt::print(stderr, "{}\n", line);
+      }
+    }
+  }
+  system.finish();
+  if (!quiet && tty) fmt::print(stderr, "\n");
+
+  RunOutcome out;
+  out.wall_s = wall.elapsed_ms() / 1000.0;
+  out.frames = records.size();
+  for (const auto& r : records) {
+    out.tracked += r.result.state == TrackState::Ok ? 1 : 0;
+    out.lost += r.result.state == TrackState::Lost ? 1 : 0;
+    out.not_initialised += r.result.state == TrackState::NotInitialised ? 1 : 0;
+    out.keyframes += r.result.keyframe ? 1 : 0;
+  }
+
+  // Poses of cam0 (KITTI's reference camera) in the world of the ground truth when there is one (so
+  // that files line up with poses/NN.txt), else in the first frame's cam0.
+  const auto trajectory = system.trajectory();
+  const Eigen::Isometry3d T_cam_cam0 = p.calibration.T_cam_cam0;
+  const auto& gt = p.sequence->ground_truth();
+  Eigen::Isometry3d T_world_first = Eigen::Isometry3d::Identity();
+  if (gt && p.first < gt->size()) T_world_first = gt->poses[p.first];
+  Trajectory estimate;
+  for (const auto& pose : trajectory) {
+    estimate.timestamps.push_back(pose.timestamp);
+    estimate.poses.push_back(T_world_first * T_cam_cam0.inverse() * pose.T_world_cam * T_cam_cam0);
+  }
+  write_kitti_trajectory(out_dir / "trajectory_kitti.txt", estimate.poses);
+  write_tum_trajectory(out_dir / "trajectory_tum.txt", estimate);
+
+  // timing.csv: a row per frame, a column per stage
+  {
+    std::ofstream csv(out_dir / "timing.csv");
+    csv << "frame,timestamp,state,keyframe,keypoints,keypoints_with_depth,inliers,io_wait_ms,depth_ms,"
+           "extraction_ms,tracking_ms,mapping_ms,total_ms\n";
+    for (const auto& r : records) {
+      const auto& t = r.result.timing;
+      csv << fmt::format("{},{:.6f},{},{},{},{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f}\n", r.result.frame_index,
+                         r.result.timestamp, to_string(r.result.state), r.result.keyframe ? 1 : 0,
+                         r.result.keypoints, r.result.keypoints_with_depth, r.result.inliers, r.io_wait_ms,
+                         t.depth_ms, t.extraction_ms, t.tracking_ms, t.mapping_ms, t.total_ms);
+    }
+    if (!csv) throw Error(fmt::format("{}: cannot write", (out_dir / "timing.csv").string()));
+  }
+
+  // metrics against ground truth over the frames it covers
+  std::vector<Eigen::Isometry3d> est_poses, gt_poses;
+  if (gt) {
+    for (std::size_t i = 0; i < estimate.poses.size() && p.first + i < gt->size(); ++i) {
+      est_poses.push_back(estimate.poses[i]);
+      gt_poses.push_back(gt->poses[p.first + i]);
+    }
+  }
+  std::string metrics_json = "null";
+  if (gt_poses.size() >= 2) {
+    const auto ate = absolute_trajectory_error(est_poses, gt_poses);
+    const auto drift = end_point_drift(est_poses, gt_poses);
+    const auto rpe = relative_pose_error(est_poses, gt_poses, 1);
+    const auto kitti = kitti_metric(est_poses, gt_poses, kitti_lengths_for(drift.path_length, out.kitti_lengths));
+    out.ate_rmse_m = ate.translation.rmse;
+    out.drift_percent = drift.percent;
+    out.kitti_t_err_percent = kitti.t_err_percent;
+    out.kitti_r_err_deg_per_100m = kitti.r_err_deg_per_100m;
+    metrics_json = fmt::format(
+        "{{\"frames_with_ground_truth\": {}, \"path_length_m\": {}, \"ate_rmse_m\": {}, \"ate_max_m\": {}, "
+        "\"end_point_drift_m\": {}, \"end_point_drift_percent\": {}, \"rpe_translation_rmse_m\": {}, "
+        "\"rpe_rotation_rmse_deg\": {}, \"kitti\": {{\"lengths\": {}, \"segments\": {}, \"t_err_percent\": {}, "
+        "\"r_err_deg_per_100m\": {}}}}}",
+        gt_poses.size(), json_number(drift.path_length), json_number(ate.translation.rmse),
+        json_number(ate.translation.max), json_number(drift.end_error), json_number(drift.percent),
+        json_number(rpe.translation.rmse), json_number(rpe.rotation_deg.rmse), json_string(out.kitti_lengths),
+        kitti.segments, json_number(kitti.t_err_percent), json_number(kitti.r_err_deg_per_100m));
+  }
+
+  // trajectory plot against ground truth
+  {
+    std::vector<PlotSeries> series;
+    if (!gt_poses.empty()) {
+      PlotSeries g{"ground truth", "#444444", {}, true};
+      for (const auto& T : gt_poses) g.positions.push_back(T.translation());
+      series.push_back(std::move(g));
+    }
+    PlotSeries e{fmt::format("rgbl ({})", p.depth_name), "#d62728", {}, false};
+    for (std::size_t i = 0; i < estimate.poses.size(); ++i) {
+      const bool ok = i < records.size() && records[i].result.state == TrackState::Ok;
+      e.positions.push_back(ok ? Eigen::Vector3d(estimate.poses[i].translation())
+                               : Eigen::Vector3d::Constant(std::nan("")));
+    }
+    series.push_back(std::move(e));
+    write_trajectory_svg(out_dir / "trajectory.svg", series,
+                         fmt::format("{}: camera {}, depth {}", p.sequence->name(), p.camera, p.depth_name));
+  }
+
+  // the map: landmarks and keyframe poses, in the same world frame as the trajectory files
+  {
+    const Map& map = system.map();
+    std::shared_lock lock(map.mutex());
+    const Eigen::Isometry3d T_out_world = T_world_first * T_cam_cam0.inverse();
+    std::vector<Eigen::Vector3d> points;
+    for (const auto id : map.landmark_ids()) {
+      if (const Landmark* l = map.landmark(id)) points.push_back(T_out_world * l->position);
+    }
+    std::vector<Eigen::Isometry3d> cameras;
+    for (const auto id : map.keyframe_ids()) {
+      if (const auto T_cam_world = map.keyframe_pose(id)) cameras.push_back(T_out_world * T_cam_world->inverse() * T_cam_cam0);
+    }
+    out.landmarks = points.size();
+    write_ply(out_dir / "map.ply", points, {}, cameras);
+  }
+
+  std::vector<double> depth_ms, extraction_ms, tracking_ms, mapping_ms, total_ms, front_ms, io_ms;
+  for (const auto& r : records) {
+    const auto& t = r.result.timing;
+    depth_ms.push_back(t.depth_ms);
+    extraction_ms.push_back(t.extraction_ms);
+    tracking_ms.push_back(t.tracking_ms);
+    mapping_ms.push_back(t.mapping_ms);
+    total_ms.push_back(t.total_ms);
+    front_ms.push_back(t.depth_ms + t.extraction_ms + t.tracking_ms);
+    io_ms.push_back(r.io_wait_ms);
+  }
+  const auto front = stats(front_ms);
+  const auto total = stats(total_ms);
+  out.median_front_ms = front.median;
+  out.median_total_ms = total.median;
+  out.mean_total_ms = total.mean;
+  const auto stage_json = [](const char* name, const StageStats& s) {
+    return fmt::format("\"{}\": {{\"median\": {}, \"p95\": {}, \"mean\": {}, \"max\": {}}}", name,
+                       json_number(s.median), json_number(s.p95), json_number(s.mean), json_number(s.max));
+  };
+  std::string lost_frames;
+  for (const auto& r : records) {
+    if (r.result.state != TrackState::Lost) continue;
+    lost_frames += (lost_frames.empty() ? "" : ", ") + std::to_string(r.result.frame_index);
+  }
+  {
+    const auto file = out_dir / "summary.json";
+    std::ofstream json(file);
+    json << "{\n"
+         << fmt::format("  \"sequence\": {},\n  \"format\": {},\n  \"camera\": {},\n  \"depth\": {},\n",
+                        json_string(p.sequence->path().string()), json_string(std::string(to_string(p.sequence->format()))),
+                        p.camera, json_string(p.depth_name))
+         << fmt::format("  \"frames\": {},\n  \"tracked\": {},\n  \"lost\": {},\n  \"not_initialised\": {},\n"
+                        "  \"lost_frames\": [{}],\n  \"keyframes\": {},\n  \"landmarks\": {},\n",
+                        out.frames, out.tracked, out.lost, out.not_initialised, lost_frames, out.keyframes, out.landmarks)
+         << fmt::format("  \"threaded_mapping\": {},\n  \"wall_s\": {},\n", threaded ? "true" : "false",
+                        json_number(out.wall_s))
+         << "  \"stage_ms\": {\n    " << stage_json("io_wait", stats(io_ms)) << ",\n    "
+         << stage_json("depth", stats(depth_ms)) << ",\n    " << stage_json("extraction", stats(extraction_ms))
+         << ",\n    " << stage_json("tracking", stats(tracking_ms)) << ",\n    " << stage_json("mapping", stats(mapping_ms))
+         << ",\n    " << stage_json("depth_extraction_tracking", front) << ",\n    " << stage_json("total", total)
+         << "\n  },\n"
+         << "  \"metrics\": " << metrics_json << "\n}\n";
+    if (!json) throw Error(fmt::format("{}: cannot write", file.string()));
+  }
+
+  fmt::print("\n{} ({}), camera {}, depth {}: {} frames in {:.1f} s\n", p.sequence->name(),
+             to_string(p.sequence->format()), p.camera, p.depth_name, out.frames, out.wall_s);
+  fmt::print("  tracked {}, lost {}, not initialised {}; {} keyframes, {} landmarks\n", out.tracked, out.lost,
+             out.not_initialised, out.keyframes, out.landmarks);
+  fmt::print("  per frame (median / p95 ms): depth {:.2f} / {:.2f}, extraction {:.2f} / {:.2f}, tracking {:.2f} / "
+             "{:.2f}, mapping {:.2f} / {:.2f}\n",
+             stats(depth_ms).median, stats(depth_ms).p95, stats(extraction_ms).median, stats(extraction_ms).p95,
+             stats(tracking_ms).median, stats(tracking_ms).p95, stats(mapping_ms).median, stats(mapping_ms).p95);
+  fmt::print("  depth+extraction+tracking {:.2f} ms median; total {:.2f} ms median, {:.2f} ms mean\n", front.median,
+             total.median, total.mean);
+  if (out.ate_rmse_m) {
+    fmt::print("  ATE RMSE {:.3f} m, end-point drift {:.2f} %, KITTI metric ({}) {:.2f} % / {:.3f} deg/100m\n",
+               *out.ate_rmse_m, *out.drift_percent, out.kitti_lengths, *out.kitti_t_err_percent,
+               *out.kitti_r_err_deg_per_100m);
+  } else {
+    fmt::print("  no ground truth: no accuracy figures\n");
+  }
+  fmt::print("  outputs in {}: trajectory_kitti.txt trajectory_tum.txt timing.csv summary.json trajectory.svg "
+             "map.ply\n",
+             out_dir.string());
+  return out;
+}
+
+Command add_run_command(CLI::App& parent) {
+  auto* app = parent.add_subcommand("run", "Track a dataset and write trajectories, timings, a summary, a plot and the map");
+  auto options = std::make_shared<InputOptions>();
+  auto out_dir = std::make_shared<std::string>("rgbl_output");
+  auto threaded = std::make_shared<bool>(false);
+  add_input_options(*app, *options);
+  app->add_option("--out", *out_dir, "Output folder")->capture_default_str();
+  app->add_flag("--threaded", *threaded, "Local mapping in its own thread (default: inline, bit-for-bit reproducible)");
+  return {app, [options, out_dir, threaded, app] {
+            Pipeline pipeline = make_pipeline(*options);
+            const bool quiet = app->get_parent()->get_option("--quiet")->as<bool>();
+            for (const auto& note : pipeline.notes) fmt::print(stderr, "note: {}\n", note);
+            run_pipeline(pipeline, *out_dir, *threaded, quiet);
+            return 0;
+          }};
+}
+
+}  // namespace rgbl::cli
