@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
@@ -107,6 +108,7 @@ int run_demo(const DemoArgs& args, bool quiet) {
   const double generation_s = generation.elapsed_ms() / 1000.0;
   fmt::print("synthetic street: {} frames of a {} path ({}x{}, seed {}, {:.0f} m) generated in {:.1f} s\n",
              sim.frames, args.path, sim.width, sim.height, sim.seed, (sim.frames - 1) * sim.step(), generation_s);
+  std::fflush(stdout);  // before the run's progress on stderr
 
   InputOptions input;
   input.dir = layout.sequence_dir.string();

@@ -130,9 +130,9 @@ TEST_CASE("every depth source tracks the synthetic street", "[e2e]") {
   };
   // bounds: the figures measured with seed 1 (docs/synthetic.md) with a margin
   const std::vector<Case> cases{
-      {"lidar (diamond5)", "lidar", 1.0, 5.0},  {"lidar:ipbasic", "lidar", 1.0, 5.0},
-      {"stereo (SGBM)", "stereo", 1.0, 5.0},    {"rgbd (exact depth)", "rgbd", 1.0, 5.0},
-      {"precomputed (exact)", "precomputed", 1.0, 5.0},
+      {"lidar (diamond5)", "lidar", 0.30, 1.5},     {"lidar:ipbasic", "lidar", 0.40, 2.0},
+      {"stereo (SGBM)", "stereo", 0.65, 3.0},       {"rgbd (exact depth)", "rgbd", 0.20, 0.8},
+      {"precomputed (exact)", "precomputed", 0.15, 0.6},
   };
   for (const auto& c : cases) {
     DYNAMIC_SECTION(c.label) {
@@ -188,13 +188,20 @@ TEST_CASE("the 5x5 diamond against the exact depth", "[e2e][depth]") {
   print("sparse", s);
   print("diamond5", d);
   print("ip_basic", ip);
-  // the scan itself: range noise (2 cm) and the LiDAR's parallax at occlusion edges
-  CHECK(s.coverage == Approx(0.0).margin(1.0));
-  CHECK(s.mae < 1.0);
-  // the diamond fills 13 pixels from each sample: more coverage, errors at depth edges
-  CHECK(d.coverage > s.coverage);
-  CHECK(d.mae < 1.0);
-  CHECK(d.rmse < 1.0);
+  // Measured with seed 1 (every 5th frame of the curve): sparse coverage 0.158, MAE 0.21 m, RMSE 1.82 m;
+  // diamond5 0.567, 0.51 m, 2.57 m; IP-Basic 0.599, 0.68 m, 3.09 m. The RMSE is dominated by depth
+  // edges: the LiDAR sits 33 cm behind the camera and sees background the camera does not.
+  CHECK(s.coverage > 0.12);
+  CHECK(s.coverage < 0.20);
+  CHECK(s.mae < 0.3);
+  CHECK(s.rmse < 2.5);
+  // the diamond fills 13 pixels around each sample: ~3.5x the coverage, errors at depth edges
+  CHECK(d.coverage > 0.50);
+  CHECK(d.coverage < 0.65);
+  CHECK(d.mae < 0.7);
+  CHECK(d.rmse < 3.5);
+  CHECK(d.imae < 3.0);
+  CHECK(d.irmse < 14.0);
   CHECK(ip.coverage > d.coverage);
 }
 
@@ -220,6 +227,7 @@ void check_survived(const SimData& data, const RunResult& run, int first_bad, in
   std::string states;
   for (const auto& r : run.results) states += r.state == rgbl::TrackState::Ok ? 'o' : (r.state == rgbl::TrackState::Lost ? 'L' : 'n');
   fmt::print("e2e states {} (trouble in frames {}..{})\n", states, first_bad, last_bad);
+
 }
 
 }  // namespace
@@ -236,6 +244,30 @@ TEST_CASE("an untextured stretch is survived", "[e2e]") {
   const RunResult run = track(data, "lidar", depth_settings(data));
   report("untextured 15..22", run, data.frames.size());
   check_survived(data, run, 15, 22);
+  // Plain surfaces still have corners (object outlines, shading of faces, markings' edges): ORB finds
+  // ~1100 instead of ~1950 keypoints there and tracking holds (measured: 40/40, ATE 0.06 m).
+  for (int i = 15; i <= 22; ++i) CHECK(run.results[static_cast<std::size_t>(i)].keypoints < 1500);
+  CHECK(run.tracked == data.frames.size());
+  CHECK(run.ate < 0.15);
+}
+
+TEST_CASE("a blank camera is survived: lost, then relocalised", "[e2e]") {
+  SimData data = curve_street();  // a copy: frames 20..24 see nothing at all
+  data.frames.resize(40);
+  data.poses.resize(40);
+  for (int i = 20; i <= 24; ++i) {
+    data.frames[static_cast<std::size_t>(i)].left = cv::Mat(data.frames[0].left.size(), CV_8UC1, cv::Scalar(128));
+    data.frames[static_cast<std::size_t>(i)].right = data.frames[static_cast<std::size_t>(i)].left;
+  }
+  const RunResult run = track(data, "lidar", depth_settings(data));
+  report("blank camera 20..24", run, data.frames.size());
+  check_survived(data, run, 20, 24);
+  // nothing to see: lost, reported as such; relocalised on the map at the first image again
+  // (measured: frame 25, then tracked to the end; ATE 0.14 m)
+  for (int i = 20; i <= 24; ++i) CHECK(run.results[static_cast<std::size_t>(i)].state == rgbl::TrackState::Lost);
+  for (std::size_t i = 27; i < run.results.size(); ++i) CHECK(run.results[i].state == rgbl::TrackState::Ok);
+  CHECK(run.tracked >= 33);
+  CHECK(run.ate < 0.3);
 }
 
 TEST_CASE("dropped scans are survived", "[e2e]") {
@@ -250,4 +282,8 @@ TEST_CASE("dropped scans are survived", "[e2e]") {
   const RunResult run = track(data, "lidar", depth_settings(data));
   report("dropped scans", run, data.frames.size());
   check_survived(data, run, 15, 22);
+  // frames without depth are tracked on the map alone (measured: 40/40, ATE 0.06 m)
+  for (const int i : data.options.dropped_scans) CHECK(run.results[static_cast<std::size_t>(i)].keypoints_with_depth == 0);
+  CHECK(run.tracked == data.frames.size());
+  CHECK(run.ate < 0.15);
 }
