@@ -32,7 +32,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct DemoArgs {
-  int frames = 60;
+  int frames = 0;  // 0: 60 (a bend of the curve), 80 for a loop (the shortest that closes)
   std::string path = "curve";
   std::uint64_t seed = 1;
   std::string depth = "lidar";
@@ -65,7 +65,7 @@ class TempFolder {
 
 int run_demo(const DemoArgs& args, bool quiet) {
   SyntheticOptions sim;
-  sim.frames = args.frames;
+  sim.frames = args.frames > 0 ? args.frames : (args.path == "loop" ? 80 : 60);
   sim.seed = args.seed;
   sim.path.kind = *parse_path_kind(args.path);  // CLI11 checked the name
   sim.depth_camera = 0;                          // the exact depth of the camera `run` tracks by default
@@ -82,6 +82,15 @@ int run_demo(const DemoArgs& args, bool quiet) {
     }
   }
   sim.validate();
+
+  // refuse what cannot work before spending the generation time on it
+  const std::string depth_name = args.depth.substr(0, args.depth.find(':'));
+  if (depth_name != "lidar" && depth_name != "stereo" && depth_name != "precomputed") {
+    throw ConfigError("--depth", fmt::format("lidar[:...], stereo or precomputed[:<dir>] for the demo's KITTI layout "
+                                             "(it has no depth-camera images for rgbd; `precomputed` reads the "
+                                             "exact depth), not '{}'",
+                                             args.depth));
+  }
 
   std::optional<TempFolder> temp;
   fs::path root;
@@ -136,9 +145,8 @@ Command add_demo_command(CLI::App& parent) {
   auto* app = parent.add_subcommand(
       "demo", "Generate a synthetic street with exact ground truth and track it like `rgbl run` (no dataset needed)");
   auto args = std::make_shared<DemoArgs>();
-  app->add_option("--frames", args->frames, "Frames to generate and track (1 m apart; a loop needs >= 77)")
-      ->check(CLI::Range(2, 100000))
-      ->capture_default_str();
+  app->add_option("--frames", args->frames, "Frames to generate and track, 1 m apart (default: 60; 80 for a loop, which needs >= 77)")
+      ->check(CLI::Range(2, 100000));
   app->add_option("--path", args->path, "Camera path")
       ->check(CLI::IsMember({"straight", "curve", "loop"}))
       ->capture_default_str();
