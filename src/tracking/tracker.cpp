@@ -473,7 +473,9 @@ bool Tracker::relocalise(Frame& frame) {
     }
   }
   const auto matches = detail::match_brute_force(frame.descriptors, train, options_.max_hamming, 0.75);
-  if (static_cast<int>(matches.size()) < options_.relocalisation_min_inliers) return false;
+  // A hypothesis needs only a few matches: the map-wide ratio test keeps few of them. It is accepted
+  // only when the local-map search from its pose then finds relocalisation_min_inliers (as ORB-SLAM).
+  if (static_cast<int>(matches.size()) < options_.relocalisation_min_matches) return false;
   std::vector<cv::Point3f> object;
   std::vector<cv::Point2f> image;
   for (const auto& [q, t] : matches) {
@@ -489,7 +491,7 @@ bool Tracker::relocalise(Frame& frame) {
                           cv::SOLVEPNP_EPNP)) {
     return false;
   }
-  if (static_cast<int>(inlier_indices.size()) < options_.relocalisation_min_inliers) return false;
+  if (static_cast<int>(inlier_indices.size()) < options_.min_pose_inliers) return false;
   cv::Mat R;
   cv::Rodrigues(rvec, R);
   Eigen::Matrix3d Re;
@@ -503,7 +505,7 @@ bool Tracker::relocalise(Frame& frame) {
   }
   const int inliers = optimise_pose(frame);
   discard_outliers(frame);
-  if (inliers < options_.relocalisation_min_inliers) return false;
+  if (inliers < options_.min_pose_inliers) return false;
   last_relocalisation_frame_ = frame.index;
   return true;
 }

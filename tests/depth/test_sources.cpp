@@ -79,7 +79,12 @@ TEST_CASE("lidar source: projects, samples keypoints and agrees with its dense m
   const auto registry = rgbl::DepthSourceRegistry::with_builtins();
   auto source = registry.create("lidar", simple_settings());
   CHECK(source->name() == "lidar");
-  CHECK_THROWS_WITH(source->prepare({}), Contains("frame.scan"));
+  // an empty scan (a dropout) is a frame without depth, not an error
+  source->prepare({});
+  std::vector<rgbl::KeypointDepth> none(1);
+  source->sample(std::vector<Eigen::Vector2f>{{33.0F, 24.0F}}, none);
+  CHECK(none[0].z == 0.0F);
+  CHECK(cv::countNonZero(source->dense_depth()) == 0);
   const std::vector<rgbl::LidarPoint> scan = {{0.0F, 0.0F, 10.0F, 0.0F}, {0.3F, 0.0F, 20.0F, 0.0F}};  // (32,24), (33.5->34,24)
   rgbl::SensorFrame frame;
   frame.scan = scan;

@@ -24,7 +24,8 @@ struct TrackerOptions {
   int max_local_keyframes = 80;
   int min_pose_inliers = 10;            // pose optimisation success
   int min_local_map_inliers = 30;       // local-map tracking success
-  int relocalisation_min_inliers = 50;
+  int relocalisation_min_matches = 15;  // map-wide descriptor matches to try a relocalisation (PnP RANSAC)
+  int relocalisation_min_inliers = 50;  // local-map inliers to accept it
   bool keep_weak_tracking = true;       // local map fails but the motion model held: keep going, add a keyframe
   std::size_t recent_loss_frames = 5;   // after a loss, try the motion model this long before relocalising
   bool check_orientation = true;        // rotation histogram consistency in guided matching

@@ -73,7 +73,8 @@ class System {
   System(const System&) = delete;
   System& operator=(const System&) = delete;
 
-  // Throws only what the depth source throws on unusable input (e.g. no scan for a LiDAR source).
+  // Throws only what the depth source throws on unusable input (e.g. no right image for the stereo
+  // source); a frame without depth (e.g. a dropped LiDAR scan) is tracked on the map alone.
   TrackResult track(const SensorFrame& frame);
 
   // Waits until threaded mapping has processed every queued keyframe (no-op when inline).

@@ -1,0 +1,37 @@
+# `rgbl demo` on a short straight street: exit code 0, every frame tracked, accuracy against the exact
+# ground truth printed, the outputs written and the kept dataset readable by `rgbl run`.
+file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${WORK_DIR})
+execute_process(COMMAND ${RGBL} -q demo --frames 12 --path straight --seed 3 --keep ${WORK_DIR}/street
+                        --out ${WORK_DIR}/out
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}${err}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "rgbl demo failed with exit code ${rc}")
+endif()
+if(NOT out MATCHES "tracked 12, lost 0, not initialised 0")
+  message(FATAL_ERROR "not every frame tracked")
+endif()
+if(NOT out MATCHES "ATE RMSE 0\\.[0-9]+ m")
+  message(FATAL_ERROR "no accuracy below 1 m against the ground truth")
+endif()
+foreach(f trajectory_kitti.txt trajectory_tum.txt timing.csv summary.json trajectory.svg map.ply)
+  if(NOT EXISTS ${WORK_DIR}/out/${f})
+    message(FATAL_ERROR "missing output ${f}")
+  endif()
+endforeach()
+file(STRINGS ${WORK_DIR}/out/trajectory_kitti.txt poses)
+list(LENGTH poses n)
+if(NOT n EQUAL 12)
+  message(FATAL_ERROR "trajectory_kitti.txt has ${n} poses, expected 12")
+endif()
+if(NOT EXISTS ${WORK_DIR}/street/poses/00.txt OR NOT EXISTS ${WORK_DIR}/street/sequences/00/velodyne/000011.bin)
+  message(FATAL_ERROR "--keep did not keep the dataset")
+endif()
+
+# what cannot work is refused before the generation
+execute_process(COMMAND ${RGBL} demo --depth rgbd RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc EQUAL 0 OR NOT err MATCHES "^error: invalid option '--depth'")
+  message(FATAL_ERROR "--depth rgbd: expected an error naming --depth, got exit ${rc}: ${err}")
+endif()
+file(REMOVE_RECURSE ${WORK_DIR})
