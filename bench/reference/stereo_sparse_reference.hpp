@@ -4,14 +4,12 @@
 // (window loop innermost), the same texture and uniqueness tests, a parabola through the three costs
 // around the minimum. No pyramid, no candidate-parallel cost accumulation.
 
-#include <opencv2/core.hpp>
-
 #include <Eigen/Core>
-
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
+#include <opencv2/core.hpp>
 #include <vector>
 
 namespace rgbl::reference {
@@ -30,7 +28,8 @@ inline void stereo_sparse(const cv::Mat& left, const cv::Mat& right, const std::
     if (y - h < 0 || y + h >= left.rows || x - h < 0 || x + h >= left.cols) continue;
     int gradient = 0;
     for (int j = -h; j <= h; ++j) {
-      for (int i = -h; i < h; ++i) gradient += std::abs(left.at<std::uint8_t>(y + j, x + i + 1) - left.at<std::uint8_t>(y + j, x + i));
+      for (int i = -h; i < h; ++i)
+        gradient += std::abs(left.at<std::uint8_t>(y + j, x + i + 1) - left.at<std::uint8_t>(y + j, x + i));
     }
     if (static_cast<float>(gradient) < min_texture * static_cast<float>((2 * h + 1) * 2 * h)) continue;
     const int d_max = std::min(max_disparity, x - h);
@@ -38,7 +37,8 @@ inline void stereo_sparse(const cv::Mat& left, const cv::Mat& right, const std::
     for (int d = 0; d <= d_max; ++d) {
       int sad = 0;
       for (int j = -h; j <= h; ++j) {
-        for (int i = -h; i <= h; ++i) sad += std::abs(left.at<std::uint8_t>(y + j, x + i) - right.at<std::uint8_t>(y + j, x - d + i));
+        for (int i = -h; i <= h; ++i)
+          sad += std::abs(left.at<std::uint8_t>(y + j, x + i) - right.at<std::uint8_t>(y + j, x - d + i));
       }
       cost[static_cast<std::size_t>(d)] = sad;
       if (best < 0 || sad < cost[static_cast<std::size_t>(best)]) best = d;

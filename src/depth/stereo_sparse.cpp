@@ -2,17 +2,17 @@
 // texture test, SAD search along the row on the half-resolution level over the whole disparity range
 // with a uniqueness test, then a +-3 px SAD search at full resolution and a parabola through the three
 // costs around the minimum for the sub-pixel disparity.
-#include "rgbl/core/error.hpp"
-#include "rgbl/depth/sources.hpp"
-
 #include <fmt/format.h>
-#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 #include <vector>
+
+#include "rgbl/core/error.hpp"
+#include "rgbl/depth/sources.hpp"
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define RGBL_CLONES_AVX2 __attribute__((target_clones("arch=x86-64-v3", "default")))
@@ -28,7 +28,8 @@ void StereoSparseSourceOptions::validate() const {
   require(window >= 3 && window <= 15 && window % 2 == 1, "stereo_sparse.window", "an odd size in [3, 15]");
   require(coarse_window >= 3 && coarse_window <= 15 && coarse_window % 2 == 1, "stereo_sparse.coarse_window",
           "an odd size in [3, 15]");
-  require(uniqueness_ratio >= 0 && uniqueness_ratio < 100, "stereo_sparse.uniqueness_ratio", "a percentage in [0, 100)");
+  require(uniqueness_ratio >= 0 && uniqueness_ratio < 100, "stereo_sparse.uniqueness_ratio",
+          "a percentage in [0, 100)");
   require(min_texture >= 0.0F, "stereo_sparse.min_texture", "a gradient >= 0");
   require(max_mean_sad > 0.0F, "stereo_sparse.max_mean_sad", "a grey-level difference > 0");
   require(min_disparity_px > 0.0F, "stereo_sparse.min_disparity_px", "a disparity > 0 px");
@@ -38,6 +39,9 @@ void StereoSparseSourceOptions::validate() const {
 }
 
 namespace {
+
+constexpr int kLanes = 16;  // 16-bit costs in a 256-bit vector
+int padded(int n) { return (n + kLanes - 1) / kLanes * kLanes; }
 
 // cost[k] = SAD between the left window centred at (xl, y) and the right window centred at (x0 + k, y),
 // for k in [0, n). The inner loop runs over contiguous right pixels, so it vectorises across
@@ -114,18 +118,23 @@ class StereoSparseDepthSource final : public DepthSource {
       throw ConfigError("frame.image", "8-bit images (CV_8UC1 or CV_8UC3) for the stereo_sparse source");
     }
     cv::pyrDown(left_, left_half_);
-    cv::pyrDown(right_, right_half_);
+    cv::Mat right_half;
+    cv::pyrDown(right_, right_half);
+    // The right images get kLanes columns of padding so that row_sad always evaluates whole vectors
+    // of candidates (the extra ones read the padding and are ignored).
+    cv::copyMakeBorder(right_, right_padded_, 0, 0, 0, kLanes, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::copyMakeBorder(right_half, right_half_padded_, 0, 0, 0, kLanes, cv::BORDER_CONSTANT, cv::Scalar(0));
   }
 
   void sample(std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) const override {
-    std::vector<std::uint16_t> cost(static_cast<std::size_t>(options_.max_disparity / 2 + 8));
+    std::vector<std::uint16_t> cost(static_cast<std::size_t>(padded(options_.max_disparity / 2 + 2)));
     for (std::size_t i = 0; i < pixels.size(); ++i) out[i] = match(pixels[i], cost);
   }
 
   cv::Mat_<float> dense_depth() const override {
     cv::Mat_<float> depth(camera_.height, camera_.width, 0.0F);
     if (left_.empty()) return depth;
-    std::vector<std::uint16_t> cost(static_cast<std::size_t>(options_.max_disparity / 2 + 8));
+    std::vector<std::uint16_t> cost(static_cast<std::size_t>(padded(options_.max_disparity / 2 + 2)));
     for (int y = 0; y < depth.rows; y += options_.dense_step) {
       for (int x = 0; x < depth.cols; x += options_.dense_step) {
         depth(y, x) = match(Eigen::Vector2f(static_cast<float>(x), static_cast<float>(y)), cost).z;
@@ -154,15 +163,18 @@ class StereoSparseDepthSource final : public DepthSource {
     const int x1 = x / 2;
     const int y1 = y / 2;
     if (y1 - hc < 0 || y1 + hc >= left_half_.rows || x1 - hc < 0 || x1 + hc >= left_half_.cols) return {};
+    // (row_sad reads up to padded(n) - 1 candidates right of x0: within the kLanes padding columns)
     const int dc_max = std::min((options_.max_disparity + 1) / 2, x1 - hc);
     if (dc_max < 2) return {};
     const int nc = dc_max + 1;
-    row_sad(left_half_, right_half_, x1, y1, hc, x1 - dc_max, nc, cost.data());
+    row_sad(left_half_, right_half_padded_, x1, y1, hc, x1 - dc_max, padded(nc), cost.data());
     int best = 0;
-    for (int k = 1; k < nc; ++k) best = cost[static_cast<std::size_t>(k)] < cost[static_cast<std::size_t>(best)] ? k : best;
+    for (int k = 1; k < nc; ++k)
+      best = cost[static_cast<std::size_t>(k)] < cost[static_cast<std::size_t>(best)] ? k : best;
     const int best_cost = cost[static_cast<std::size_t>(best)];
     for (int k = 0; k < nc; ++k) {
-      if (std::abs(k - best) > 1 && cost[static_cast<std::size_t>(k)] * (100 - options_.uniqueness_ratio) <= best_cost * 100) {
+      if (std::abs(k - best) > 1 &&
+          cost[static_cast<std::size_t>(k)] * (100 - options_.uniqueness_ratio) <= best_cost * 100) {
         return {};  // repetitive texture or occlusion: another disparity is nearly as good
       }
     }
@@ -174,7 +186,7 @@ class StereoSparseDepthSource final : public DepthSource {
     const int nf = d_hi - d_lo + 1;
     if (nf < 3) return {};
     const int x0 = x - d_hi;
-    row_sad(left_, right_, x, y, h, x0, nf, cost.data());
+    row_sad(left_, right_padded_, x, y, h, x0, padded(nf), cost.data());
     int kf = 0;
     for (int k = 1; k < nf; ++k) kf = cost[static_cast<std::size_t>(k)] < cost[static_cast<std::size_t>(kf)] ? k : kf;
     if (kf == 0 || kf == nf - 1) return {};  // minimum on the border: no parabola, likely a wrong coarse match
@@ -206,7 +218,7 @@ class StereoSparseDepthSource final : public DepthSource {
   double baseline_;
   StereoSparseSourceOptions options_;
   float fb_ = 0.0F;
-  cv::Mat left_, right_, left_half_, right_half_;
+  cv::Mat left_, right_, left_half_, right_padded_, right_half_padded_;
 };
 
 }  // namespace
