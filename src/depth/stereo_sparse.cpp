@@ -123,6 +123,7 @@ class StereoSparseDepthSource final : public DepthSource {
     // The right images get kLanes columns of padding so that row_sad always evaluates whole vectors
     // of candidates (the extra ones read the padding and are ignored).
     cv::copyMakeBorder(right_, right_padded_, 0, 0, 0, kLanes, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::copyMakeBorder(left_half_, left_half_padded_, 0, 0, 0, kLanes, cv::BORDER_CONSTANT, cv::Scalar(0));
     cv::copyMakeBorder(right_half, right_half_padded_, 0, 0, 0, kLanes, cv::BORDER_CONSTANT, cv::Scalar(0));
   }
 
@@ -149,6 +150,17 @@ class StereoSparseDepthSource final : public DepthSource {
       throw ConfigError(key, fmt::format("an image of the camera's size {}x{} (got {}x{})", camera_.width,
                                          camera_.height, image.cols, image.rows));
     }
+  }
+
+  // Left-right check on the half level: the right window at xr (matched at disparity dc) searched
+  // along the left row must come back to within 1 px of dc (occlusions and wrong matches do not).
+  bool consistent(int xr, int y, int half, int dc, std::vector<std::uint16_t>& cost) const {
+    const int n = std::min((options_.max_disparity + 1) / 2, left_half_.cols - 1 - half - xr) + 1;
+    if (n < 2) return true;  // nothing to check against at the right border
+    row_sad(right_half_padded_, left_half_padded_, xr, y, half, xr, padded(n), cost.data());
+    int best = 0;
+    for (int k = 1; k < n; ++k) best = cost[static_cast<std::size_t>(k)] < cost[static_cast<std::size_t>(best)] ? k : best;
+    return std::abs(best - dc) <= 1;
   }
 
   KeypointDepth match(const Eigen::Vector2f& px, std::vector<std::uint16_t>& cost) const {
@@ -179,6 +191,7 @@ class StereoSparseDepthSource final : public DepthSource {
       }
     }
     const int dc = dc_max - best;
+    if (options_.left_right_check && !consistent(x1 - dc, y1, hc, dc, cost)) return {};
 
     // Fine: +-3 px around 2 * dc at full resolution (the half level rounds x and the disparity).
     const int d_lo = std::max(2 * dc - 3, 0);
@@ -218,7 +231,7 @@ class StereoSparseDepthSource final : public DepthSource {
   double baseline_;
   StereoSparseSourceOptions options_;
   float fb_ = 0.0F;
-  cv::Mat left_, right_, left_half_, right_padded_, right_half_padded_;
+  cv::Mat left_, right_, left_half_, right_padded_, right_half_padded_, left_half_padded_;
 };
 
 }  // namespace

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <opencv2/core.hpp>
@@ -218,24 +219,40 @@ TEST_CASE("stereo_sparse on real KITTI frames: exact on a shifted real image, cl
     CHECK(error[error.size() * 9 / 10] < 0.1);
   }
 
-  stereo->prepare(frame);
   lidar->prepare(frame);
-  std::vector<rgbl::KeypointDepth> zs(pixels.size()), zl(pixels.size());
-  stereo->sample(pixels, zs);
+  std::vector<rgbl::KeypointDepth> zl(pixels.size());
   lidar->sample(pixels, zl);
-  std::vector<double> relative;
-  for (std::size_t i = 0; i < pixels.size(); ++i) {
-    // close range (what the tracker uses), near a real LiDAR sample, not on a LiDAR depth edge
-    if (zs[i].z <= 0.0F || zl[i].z <= 0.0F || zl[i].z > 20.0F || zl[i].sample_distance_px > 1.5F) continue;
-    if (zl[i].spread > 0.5F) continue;
-    relative.push_back(std::abs(zs[i].z - zl[i].z) / zl[i].z);
-  }
-  REQUIRE(relative.size() > 1000);
-  std::sort(relative.begin(), relative.end());
-  const double median = relative[relative.size() / 2];
-  const double p75 = relative[relative.size() * 3 / 4];
-  INFO("stereo_sparse vs LiDAR, frame 0: " << relative.size() << " points, median |dz|/z " << median << ", p75 "
-                                           << p75);
-  CHECK(median < 0.035);
-  CHECK(p75 < 0.08);
+  // |dz|/z against the LiDAR: close range (what the tracker uses), near a real LiDAR sample, off LiDAR
+  // depth edges; returns the count, median and 75th percentile
+  const auto compare = [&](const rgbl::DepthSource& source) {
+    std::vector<rgbl::KeypointDepth> zs(pixels.size());
+    source.sample(pixels, zs);
+    std::vector<double> relative;
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      if (zs[i].z <= 0.0F || zl[i].z <= 0.0F || zl[i].z > 20.0F || zl[i].sample_distance_px > 1.5F) continue;
+      if (zl[i].spread > 0.5F) continue;
+      relative.push_back(std::abs(zs[i].z - zl[i].z) / zl[i].z);
+    }
+    std::sort(relative.begin(), relative.end());
+    if (relative.empty()) relative.push_back(1.0);
+    return std::array<double, 3>{static_cast<double>(relative.size()), relative[relative.size() / 2],
+                                 relative[relative.size() * 3 / 4]};
+  };
+  stereo->prepare(frame);
+  const auto plain = compare(*stereo);
+  INFO("stereo_sparse vs LiDAR, frame 0: " << plain[0] << " points, median |dz|/z " << plain[1] << ", p75 "
+                                           << plain[2]);
+  CHECK(plain[0] > 1000);
+  CHECK(plain[1] < 0.035);
+  CHECK(plain[2] < 0.08);
+
+  // the left-right check drops some of the disagreeing matches
+  s.stereo_sparse.left_right_check = true;
+  auto checked_source = registry.create("stereo_sparse", s);
+  checked_source->prepare(frame);
+  const auto checked = compare(*checked_source);
+  INFO("with the left-right check: " << checked[0] << " points, median " << checked[1] << ", p75 " << checked[2]);
+  CHECK(checked[0] < plain[0]);
+  CHECK(checked[0] > 0.9 * plain[0]);
+  CHECK(checked[2] < plain[2]);
 }

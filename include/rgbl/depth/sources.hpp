@@ -64,6 +64,9 @@ struct StereoSparseSourceOptions {
   int window = 11;                 // odd SAD window at full resolution (ORB-SLAM: 11)
   int coarse_window = 7;           // odd SAD window on the half-resolution level
   int uniqueness_ratio = 10;       // percent the best coarse cost must beat the best outside +-1 disparity
+  // The right patch searched back along the left row must agree (+-1 coarse px). Off by default: on
+  // seq 04 it drops ~1.4 % of the depths, ATE 0.258 -> 0.255 m, for +1.3 ms per 2000 keypoints.
+  bool left_right_check = false;
   float min_texture = 3.0F;        // mean |horizontal gradient| over the window, grey levels; below: no depth
   float max_mean_sad = 20.0F;      // mean |left - right| per pixel at the best match, grey levels
   float min_disparity_px = 1.0F;   // disparities below are dropped (depth too far to trust)
