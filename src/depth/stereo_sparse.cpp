@@ -120,10 +120,12 @@ class StereoSparseDepthSource final : public DepthSource {
     cv::pyrDown(left_, left_half_);
     cv::Mat right_half;
     cv::pyrDown(right_, right_half);
-    // The right images get kLanes columns of padding so that row_sad always evaluates whole vectors
+    // The searched images get kLanes columns of padding so that row_sad always evaluates whole vectors
     // of candidates (the extra ones read the padding and are ignored).
     cv::copyMakeBorder(right_, right_padded_, 0, 0, 0, kLanes, cv::BORDER_CONSTANT, cv::Scalar(0));
-    cv::copyMakeBorder(left_half_, left_half_padded_, 0, 0, 0, kLanes, cv::BORDER_CONSTANT, cv::Scalar(0));
+    if (options_.left_right_check) {
+      cv::copyMakeBorder(left_half_, left_half_padded_, 0, 0, 0, kLanes, cv::BORDER_CONSTANT, cv::Scalar(0));
+    }
     cv::copyMakeBorder(right_half, right_half_padded_, 0, 0, 0, kLanes, cv::BORDER_CONSTANT, cv::Scalar(0));
   }
 
