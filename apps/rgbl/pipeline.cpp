@@ -12,7 +12,7 @@ namespace rgbl::cli {
 namespace {
 
 // --depth: lidar | lidar:ipbasic | lidar:ipbasic-multiscale | lidar:<kernel><size> (e.g. lidar:diamond7)
-// | precomputed:<dir> | stereo | rgbd
+// | precomputed:<dir> | stereo | stereo_sparse | rgbd
 void apply_depth_spec(const std::string& spec, Pipeline& p) {
   const auto colon = spec.find(':');
   const std::string name = spec.substr(0, colon);
@@ -39,10 +39,10 @@ void apply_depth_spec(const std::string& spec, Pipeline& p) {
   } else if (name == "precomputed") {
     if (arg.empty()) throw ConfigError("--depth", "precomputed:<folder of uint16 depth PNGs>");
     p.depth_settings.precomputed.folder = arg;
-  } else if (name == "stereo" || name == "rgbd") {
+  } else if (name == "stereo" || name == "stereo_sparse" || name == "rgbd") {
     if (!arg.empty()) throw ConfigError("--depth", fmt::format("'{}' without an argument", name));
   } else if (!DepthSourceRegistry::with_builtins().contains(name)) {
-    throw ConfigError("--depth", fmt::format("one of lidar[:...], precomputed:<dir>, stereo, rgbd; not '{}'", spec));
+    throw ConfigError("--depth", fmt::format("one of lidar[:...], precomputed:<dir>, stereo, stereo_sparse, rgbd; not '{}'", spec));
   }
 }
 
@@ -97,7 +97,7 @@ void add_input_options(CLI::App& app, InputOptions& options) {
       ->check(CLI::IsMember({0, 2}));
   app.add_option("--depth", options.depth,
                  "Depth source: lidar (5x5 diamond), lidar:ipbasic, lidar:ipbasic-multiscale, lidar:diamond7, "
-                 "precomputed:<dir>, stereo, rgbd")
+                 "precomputed:<dir>, stereo (SGBM), stereo_sparse (keypoints only), rgbd")
       ->capture_default_str();
   app.add_option("--config", options.config, "Settings YAML (ORB-SLAM style; RGB-L LiDAR.* keys accepted)");
   app.add_option("--frames", options.frames, "Number of frames to process (default: all)");
@@ -129,9 +129,9 @@ Pipeline make_pipeline(const InputOptions& options) {
     throw ConfigError("--depth", fmt::format("a source the dataset has: {} has no LiDAR scans (try stereo or rgbd)",
                                              p.sequence->path().string()));
   }
-  if (p.depth_name == "stereo" && !sensors.cameras[static_cast<std::size_t>(p.camera + 1)]) {
-    throw ConfigError("--depth", fmt::format("stereo needs camera {} (image_{}) next to camera {}", p.camera + 1,
-                                             p.camera + 1, p.camera));
+  if ((p.depth_name == "stereo" || p.depth_name == "stereo_sparse") && !sensors.cameras[static_cast<std::size_t>(p.camera + 1)]) {
+    throw ConfigError("--depth", fmt::format("{} needs camera {} (image_{}) next to camera {}", p.depth_name,
+                                             p.camera + 1, p.camera + 1, p.camera));
   }
   if (p.depth_name == "rgbd" && !sensors.depth) {
     throw ConfigError("--depth", fmt::format("rgbd needs depth images: {} has none", p.sequence->path().string()));

@@ -36,7 +36,7 @@ struct Pipeline {
   std::unique_ptr<Sequence> sequence;
   int camera = 0;
   CameraCalibration calibration;
-  std::string depth_name;  // registry name: lidar, precomputed, stereo, rgbd
+  std::string depth_name;  // registry name: lidar, precomputed, stereo, stereo_sparse, rgbd
   DepthSourceSettings depth_settings;
   SystemOptions system;
   OrbOptions orb;

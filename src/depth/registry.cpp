@@ -11,6 +11,7 @@ DepthSourceRegistry DepthSourceRegistry::with_builtins() {
   registry.add("lidar", make_lidar_source);
   registry.add("precomputed", make_precomputed_source);
   registry.add("stereo", make_stereo_source);
+  registry.add("stereo_sparse", make_stereo_sparse_source);
   registry.add("rgbd", make_rgbd_source);
   return registry;
 }

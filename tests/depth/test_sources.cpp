@@ -53,13 +53,13 @@ class ConstantSource final : public rgbl::DepthSource {
 
 TEST_CASE("registry: built-ins, unknown names and user sources") {
   auto registry = rgbl::DepthSourceRegistry::with_builtins();
-  CHECK(registry.names() == std::vector<std::string>{"lidar", "precomputed", "rgbd", "stereo"});
+  CHECK(registry.names() == std::vector<std::string>{"lidar", "precomputed", "rgbd", "stereo", "stereo_sparse"});
   try {
     (void)registry.create("neural", simple_settings());
     FAIL("expected a ConfigError");
   } catch (const rgbl::ConfigError& e) {
     CHECK(e.key() == "depth.source");
-    CHECK_THAT(e.what(), Contains("lidar, precomputed, rgbd, stereo") && Contains("neural"));
+    CHECK_THAT(e.what(), Contains("lidar, precomputed, rgbd, stereo, stereo_sparse") && Contains("neural"));
   }
   registry.add("constant", [](const rgbl::DepthSourceSettings&) { return std::make_unique<ConstantSource>(4.0F); });
   auto source = registry.create("constant", simple_settings());

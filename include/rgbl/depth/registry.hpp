@@ -1,6 +1,6 @@
 #pragma once
 // Depth sources created by name. A registry is a plain value: start from with_builtins() (lidar,
-// precomputed, stereo, rgbd) and add your own factories; nothing is global.
+// precomputed, stereo, stereo_sparse, rgbd) and add your own factories; nothing is global.
 
 #include "rgbl/depth/depth_source.hpp"
 #include "rgbl/depth/sources.hpp"
@@ -20,7 +20,7 @@ class DepthSourceRegistry {
  public:
   // An empty registry.
   DepthSourceRegistry() = default;
-  // lidar, precomputed, stereo, rgbd.
+  // lidar, precomputed, stereo, stereo_sparse, rgbd.
   static DepthSourceRegistry with_builtins();
 
   // Adds or replaces the factory for `name`. Throws ConfigError("depth.source") for an empty name or
