@@ -6,7 +6,9 @@
 
 #include <fmt/format.h>
 
+#include <charconv>
 #include <cmath>
+#include <system_error>
 
 namespace rgbl::cli {
 namespace {
@@ -34,7 +36,15 @@ void apply_depth_spec(const std::string& spec, Pipeline& p) {
                                                  spec));
       }
       lidar.dilation.shape = parse_kernel_shape(arg.substr(0, digit), "--depth");
-      lidar.dilation.size = std::stoi(arg.substr(digit));
+      // std::stoi would accept "7x" and throw a bare "stoi" on overflow: parse the whole tail.
+      const std::string size = arg.substr(digit);
+      int value = 0;
+      const auto [end, ec] = std::from_chars(size.data(), size.data() + size.size(), value);
+      if (ec != std::errc() || end != size.data() + size.size() || value < 1 || value > 63 || value % 2 == 0) {
+        throw ConfigError("--depth", fmt::format("an odd kernel size 1..63 after the shape (e.g. lidar:diamond5), "
+                                                 "not '{}'", spec));
+      }
+      lidar.dilation.size = value;
     }
   } else if (name == "precomputed") {
     if (arg.empty()) throw ConfigError("--depth", "precomputed:<folder of uint16 depth PNGs>");

@@ -21,6 +21,7 @@
 #include <memory>
 #include <mutex>
 #include <shared_mutex>
+#include <system_error>
 #include <vector>
 
 namespace rgbl::cli {
@@ -83,6 +84,13 @@ struct FrameRecord {
 
 RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool threaded, bool quiet) {
   std::filesystem::create_directories(out_dir);
+  // Outputs of an earlier run in the same folder would look like this run's if it fails half-way:
+  // remove them first (a successful run overwrites them anyway).
+  for (const char* name : {"trajectory_kitti.txt", "trajectory_tum.txt", "timing.csv", "summary.json",
+                           "trajectory.svg", "map.ply"}) {
+    std::error_code ec;
+    std::filesystem::remove(out_dir / name, ec);
+  }
   SystemOptions system_options = p.system;
   system_options.threaded_mapping = threaded;
   System system(system_options, p.calibration, p.make_depth_source(), p.make_extractor());

@@ -132,9 +132,14 @@ class LidarDepthSource final : public DepthSource {
   std::string_view name() const override { return "lidar"; }
 
   void prepare(const SensorFrame& frame) override {
-    if (frame.scan.empty()) throw ConfigError("frame.scan", "a LiDAR scan for the lidar depth source");
+    // An empty scan is a LiDAR dropout (datasets without scans are rejected before tracking starts):
+    // no depth at any pixel, so the tracker carries on with the map instead of stopping the run.
     sparse_.create(camera_.height, camera_.width);
-    project_to_depth(frame.scan, P_img_lidar_, options_.projection, sparse_);
+    if (frame.scan.empty()) {
+      sparse_.setTo(0.0F);
+    } else {
+      project_to_depth(frame.scan, P_img_lidar_, options_.projection, sparse_);
+    }
     dense_.release();
     if (options_.completion != CompletionMethod::dilation) dense_ = complete();
   }

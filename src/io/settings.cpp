@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <fstream>
 #include <iterator>
 #include <set>
@@ -126,6 +127,10 @@ Settings read_settings(const std::filesystem::path& yaml) {
   } catch (const cv::Exception& e) {
     throw ParseError(yaml, 0,
                      fmt::format("not a readable YAML settings file: expected 'Key: value' lines (OpenCV: {})", e.err));
+  } catch (const std::exception&) {
+    // OpenCV 4.6's parser lets standard exceptions escape on some malformed input (found by
+    // fuzz_settings: std::length_error on a map with an empty key, `a: { : { b: 1 "x" }`).
+    throw ParseError(yaml, 0, "not a readable YAML settings file: expected 'Key: value' lines (OpenCV's parser failed)");
   }
   if (!storage.isOpened())
     throw ParseError(yaml, 0, "cannot open (expected an ORB-SLAM style %YAML:1.0 settings file)");

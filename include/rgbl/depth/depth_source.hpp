@@ -39,7 +39,8 @@ class DepthSource {
   virtual std::string_view name() const = 0;
 
   // Per-frame work that does not depend on keypoints (e.g. projecting the scan). Throws on input the
-  // source cannot use (e.g. no scan for a LiDAR source), naming what was expected.
+  // source cannot use (e.g. an image of the wrong size), naming what was expected. A missing
+  // measurement for one frame (an empty LiDAR scan) is not an error: that frame has no depth.
   virtual void prepare(const SensorFrame& frame) = 0;
 
   // Depth at keypoint pixels, after prepare(). out.size() == pixels.size().
