@@ -132,7 +132,14 @@ Pipeline make_pipeline(const InputOptions& options) {
     p.depth_settings.stereo_baseline = kitti.baseline(p.camera, p.camera + 1);
   }
   apply_depth_spec(options.depth, p);
-  if (!options.config.empty()) apply_settings(read_settings(options.config), p);
+  if (!options.config.empty()) {
+    const Settings settings = read_settings(options.config);
+    try {
+      apply_settings(settings, p);
+    } catch (const ConfigError& e) {
+      throw ParseError(settings.file, 0, e.what());  // name the settings file, not just the key
+    }
+  }
   p.depth_settings.calibration = p.calibration;
 
   if (p.depth_name == "lidar" && !sensors.lidar) {

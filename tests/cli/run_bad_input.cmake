@@ -62,6 +62,9 @@ expect_failure("text\\.yaml: key 'ORBextractor\\.nFeatures': expected an integer
                --config ${WORK_DIR}/text.yaml)
 file(WRITE ${WORK_DIR}/partial.yaml "%YAML:1.0\nCamera.fx: 300.0\nCamera.fy: 300.0\nCamera.cx: 150.0\n")
 expect_failure("partial\\.yaml: key 'Camera\\.cy'" ${seq} --config ${WORK_DIR}/partial.yaml)
+file(WRITE ${WORK_DIR}/method.yaml "LiDAR.Method: \"Foo\"\n")
+expect_failure("method\\.yaml: invalid option 'LiDAR\\.Method': expected InverseDilation" ${seq}
+               --config ${WORK_DIR}/method.yaml)
 expect_failure("absent\\.yaml: missing or not a file" ${seq} --config ${WORK_DIR}/absent.yaml)
 
 # bad depth specs
