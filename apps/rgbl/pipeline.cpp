@@ -57,7 +57,7 @@ void apply_depth_spec(const std::string& spec, Pipeline& p) {
 }
 
 void apply_settings(const Settings& s, Pipeline& p) {
-  for (const auto& w : s.warnings) p.notes.push_back(fmt::format("{}: {}", s.file.string(), w));
+  for (const auto& w : s.warnings) p.notes.push_back(w);  // each already names the file
   p.orb.num_features = s.orb.n_features;
   p.orb.num_levels = s.orb.n_levels;
   p.orb.scale_factor = static_cast<float>(s.orb.scale_factor);
