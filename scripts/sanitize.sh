@@ -2,11 +2,12 @@
 # Runs the test suite under AddressSanitizer + UndefinedBehaviorSanitizer (preset asan), and the
 # threaded-mapping tests (label `threaded`) under ThreadSanitizer (preset tsan).
 #
-# TSan maps its shadow memory at fixed addresses and crashes at start-up ("FATAL: ThreadSanitizer:
-# unexpected memory mapping" or a plain SIGSEGV) when the kernel randomises mmap addresses with more
-# than 28 bits (vm.mmap_rnd_bits = 32 on recent kernels). `setarch -R` does not help with GCC 12's
-# runtime. So: lower vm.mmap_rnd_bits to 28 when we may (root, writable sysctl), restore it afterwards,
-# and skip TSan with a clear message only when that is impossible and a probe binary crashes.
+# Two things have made TSan binaries crash at start-up (SIGSEGV before main):
+# - ifunc resolvers instrumented by GCC (target_clones in src/depth/completion.cpp): the loader runs
+#   them before the TSan runtime exists. Fixed in the code: no clones when __SANITIZE_THREAD__.
+# - kernels that randomise mmap addresses with more than 28 bits (vm.mmap_rnd_bits = 32) collide with
+#   TSan's fixed shadow layout. We lower the sysctl to 28 when we may (root), restore it on exit, and
+#   skip TSan with a clear message only when a minimal TSan probe still crashes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
