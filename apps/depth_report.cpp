@@ -12,6 +12,7 @@
 #include "rgbl/depth/registry.hpp"
 #include "rgbl/geometry/calibration.hpp"
 #include "rgbl/geometry/projection.hpp"
+#include "rgbl/io/trajectory_io.hpp"
 
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
@@ -67,7 +68,7 @@ int main(int argc, char** argv) try {
   cv::setNumThreads(1);
   const auto seq = data / "kitti/odometry/sequences/04";
   const auto kitti = rgbl::read_kitti_odometry_calibration(seq / "calib.txt", 1226, 370);  // 04-12: 1226x370
-  const auto all_poses = rgbl::read_kitti_poses(data / "kitti/odometry/poses/04.txt");
+  const auto all_poses = rgbl::read_kitti_trajectory(data / "kitti/odometry/poses/04.txt");
   std::vector<std::vector<rgbl::LidarPoint>> scans;
   for (int i = 0; i < frame_limit; ++i) {
     const auto file = seq / "velodyne" / fmt::format("{:06d}.bin", i);

@@ -17,5 +17,6 @@ struct Command {
 Command add_eval_command(CLI::App& parent);
 Command add_info_command(CLI::App& parent);
 Command add_run_command(CLI::App& parent);
+Command add_depth_command(CLI::App& parent);
 
 }  // namespace rgbl::cli

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
 
   const std::vector<rgbl::cli::Command> commands{
       rgbl::cli::add_run_command(app),
+      rgbl::cli::add_depth_command(app),
       rgbl::cli::add_info_command(app),
       rgbl::cli::add_eval_command(app),
   };

@@ -49,27 +49,6 @@ DepthErrors evaluate_depth(const cv::Mat_<float>& prediction, const cv::Mat_<flo
   return accumulator.result();
 }
 
-std::vector<Eigen::Isometry3d> read_kitti_poses(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw ParseError(file, 0, "a KITTI pose file (one row-major 3x4 matrix per line); cannot open it");
-  std::vector<Eigen::Isometry3d> poses;
-  std::string line;
-  std::size_t number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    std::istringstream fields(line);
-    Matrix34d M;
-    for (int i = 0; i < 12; ++i) {
-      if (!(fields >> M(i / 4, i % 4))) throw ParseError(file, number, "12 numbers (a row-major 3x4 pose)");
-    }
-    std::string extra;
-    if (fields >> extra) throw ParseError(file, number, "exactly 12 numbers (a row-major 3x4 pose)");
-    poses.push_back(isometry_from_3x4(M));
-  }
-  return poses;
-}
-
 void AccumulationOptions::validate() const {
   require(half_window >= 0, "accumulation.half_window", "a number of frames >= 0");
   require(half_window > 0 || include_center, "accumulation.include_center",

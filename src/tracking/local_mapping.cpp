@@ -92,7 +92,7 @@ int LocalMapper::create_depth_landmarks(KeyframeId id) {
 int LocalMapper::fuse_into(KeyframeId target_id, const std::vector<LandmarkId>& landmarks) {
   const Keyframe* target = map_.keyframe(target_id);
   if (target == nullptr) return 0;
-  const KeypointGrid grid(target->keypoints, camera_.width, camera_.height);
+  const FeatureGrid grid(target->keypoints, camera_.width, camera_.height);
   const Eigen::Vector3d center = target->center();
   const double scale = map_.options().scale_factor;
   const int levels = map_.options().levels;
@@ -127,7 +127,7 @@ int LocalMapper::fuse_into(KeyframeId target_id, const std::vector<LandmarkId>& 
         threshold = 7.815;
       }
       if (chi2 > threshold) continue;
-      const int d = detail::descriptor_distance(l->descriptor, target->descriptors[ks]);
+      const int d = hamming_distance(l->descriptor, target->descriptors[ks]);
       if (d < best) {
         best = d;
         best_index = k;

@@ -9,35 +9,6 @@
 #include <cmath>
 
 namespace rgbl::detail {
-namespace {
-
-// Without -mpopcnt, std::popcount is a library call (__popcountdi2) that dominated the tracker's
-// profile; the SWAR count below is branch-free and a few instructions per word.
-inline int popcount64(std::uint64_t x) noexcept {
-#if defined(__POPCNT__)
-  return std::popcount(x);
-#else
-  x = x - ((x >> 1) & 0x5555555555555555ULL);
-  x = (x & 0x3333333333333333ULL) + ((x >> 2) & 0x3333333333333333ULL);
-  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0FULL;
-  return static_cast<int>((x * 0x0101010101010101ULL) >> 56);
-#endif
-}
-
-inline int distance(const Descriptor& a, const Descriptor& b) noexcept {
-  int d = 0;
-  for (std::size_t i = 0; i < 32; i += 8) {
-    std::uint64_t wa = 0, wb = 0;
-    std::memcpy(&wa, a.data() + i, 8);
-    std::memcpy(&wb, b.data() + i, 8);
-    d += popcount64(wa ^ wb);
-  }
-  return d;
-}
-
-}  // namespace
-
-int descriptor_distance(const Descriptor& a, const Descriptor& b) noexcept { return distance(a, b); }
 
 int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates, int max_hamming, double ratio,
                     bool check_orientation, std::vector<int>* candidate_of_keypoint, DepthGate gate) {
@@ -55,7 +26,7 @@ int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates,
         const float gap = std::max(gate.min_gap, gate.sigmas * frame.depth_sigma[static_cast<std::size_t>(k)]);
         if (std::abs(frame.depth[static_cast<std::size_t>(k)] - cand.depth) > gap) continue;
       }
-      const int d = distance(cand.descriptor, frame.descriptors[static_cast<std::size_t>(k)]);
+      const int d = hamming_distance(cand.descriptor, frame.descriptors[static_cast<std::size_t>(k)]);
       if (d < best) {
         second = best;
         second_level = best_level;
@@ -128,7 +99,7 @@ std::vector<std::pair<int, int>> match_brute_force(std::span<const Descriptor> q
   for (std::size_t q = 0; q < query.size(); ++q) {
     int best = INT_MAX, second = INT_MAX, best_index = -1;
     for (std::size_t t = 0; t < train.size(); ++t) {
-      const int d = distance(query[q], train[t]);
+      const int d = hamming_distance(query[q], train[t]);
       if (d < best) {
         second = best;
         best = d;

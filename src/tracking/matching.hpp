@@ -11,9 +11,6 @@
 
 namespace rgbl::detail {
 
-// Hamming distance, same value as rgbl::hamming_distance, fast without -mpopcnt.
-int descriptor_distance(const Descriptor& a, const Descriptor& b) noexcept;
-
 struct ProjectedLandmark {
   LandmarkId id;
   Descriptor descriptor{};  // a copy: the map may change once the lock is released

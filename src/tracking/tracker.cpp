@@ -60,7 +60,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     }
     outcome.state = state_;
     last_frame_ = frame;
-    last_frame_->grid = KeypointGrid();
+    last_frame_->grid = FeatureGrid();
     return outcome;
   }
 
@@ -115,7 +115,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   outcome.state = state_;
   outcome.inliers = inliers;
   last_frame_ = frame;
-  last_frame_->grid = KeypointGrid();
+  last_frame_->grid = FeatureGrid();
   return outcome;
 }
 

@@ -1,9 +1,7 @@
 # `rgbl info` on the real KITTI excerpt: what the loader sees.
-set(dir ${DATA_DIR}/kitti/odometry/sequences/04)
-if(NOT EXISTS ${dir})
-  message("skipped: no data (${dir} not found)")
-  return()
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/data_dir.cmake)
+rgbl_find_data(kitti/odometry/sequences/04)
+set(dir ${data})
 execute_process(COMMAND ${RGBL} info ${dir} --check RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 message("${out}${err}")
 if(NOT rc EQUAL 0)

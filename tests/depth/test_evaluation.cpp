@@ -2,6 +2,7 @@
 #include "rgbl/depth/completion.hpp"
 #include "rgbl/depth/evaluation.hpp"
 #include "rgbl/depth/ip_basic.hpp"
+#include "rgbl/io/trajectory_io.hpp"
 #include "support/data.hpp"
 #include "support/temp_dir.hpp"
 
@@ -45,17 +46,6 @@ TEST_CASE("metrics on a hand-computed case") {
   CHECK(pooled.result().count == 4);
   CHECK(pooled.result().mae == Approx((1.0 + 0.0 + 3.0 + 3.0) / 4.0));
   CHECK(rgbl::evaluate_depth(cv::Mat_<float>(2, 2, 0.0F), cv::Mat_<float>(2, 2, 0.0F)).count == 0);
-}
-
-TEST_CASE("KITTI poses: parsed, and bad lines name the file and line") {
-  rgbl::test::TempDir dir;
-  const auto good = dir.write("poses.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0.5 0 1 0 0 0 0 1 2\n");
-  const auto poses = rgbl::read_kitti_poses(good);
-  REQUIRE(poses.size() == 2);
-  CHECK(poses[1].translation().isApprox(Eigen::Vector3d(0.5, 0.0, 2.0)));
-  const auto bad = dir.write("bad.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1\n");
-  CHECK_THROWS_WITH(rgbl::read_kitti_poses(bad), Contains("bad.txt:2") && Contains("12 numbers"));
-  CHECK_THROWS_AS(rgbl::read_kitti_poses(dir.path() / "missing.txt"), rgbl::ParseError);
 }
 
 TEST_CASE("accumulated ground truth places neighbouring scans with the poses, nearest first") {
@@ -103,7 +93,7 @@ TEST_CASE("real data: the 5x5 diamond against accumulated ground truth stays wit
   const auto poses_file = rgbl::test::find_data("kitti/odometry/poses/04.txt");
   if (!poses_file) return;
   const auto calib = rgbl::read_kitti_odometry_calibration(*seq / "calib.txt", 1226, 370).camera(2);
-  const auto all_poses = rgbl::read_kitti_poses(*poses_file);
+  const auto all_poses = rgbl::read_kitti_trajectory(*poses_file);
   REQUIRE(all_poses.size() == 271);
   // frames 15..35 give three centres (20, 25, 30) their +-5 neighbours
   std::vector<std::vector<rgbl::LidarPoint>> scans;

@@ -1,7 +1,7 @@
 // Local mapping in its own thread: the tests CI also runs under ThreadSanitizer (label `threaded`,
 // scripts/sanitize.sh). Keep them short: TSan makes them ~10x slower.
-#include "apps/dev/kitti_run.hpp"
 #include "reliability/failure_run.hpp"
+#include "tracking/kitti_run.hpp"
 #include "support/data.hpp"
 
 #include <catch2/catch.hpp>
@@ -9,10 +9,9 @@
 TEST_CASE("threaded mapping: seq 04 still tracked throughout") {
   const auto sequence = rgbl::test::kitti_seq04();
   if (!sequence) return;
-  rgbl::dev::RunOptions options;
-  options.camera = 0;
-  options.system.threaded_mapping = true;
-  const auto s = rgbl::dev::run_kitti_sequence(*sequence, options);
+  rgbl::SystemOptions options;
+  options.threaded_mapping = true;
+  const auto s = rgbl::test::run_sequence(*sequence, 0, 51, options);
   INFO("ATE " << s.ate_rmse << " m, drift " << s.drift_percent << " %");
   CHECK(s.frames == 51);
   CHECK(s.tracked == 51);

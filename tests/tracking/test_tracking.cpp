@@ -1,10 +1,11 @@
-#include "apps/dev/kitti_run.hpp"
+#include "kitti_run.hpp"
 #include "rgbl/core/error.hpp"
 #include "rgbl/tracking/frame.hpp"
 #include "rgbl/tracking/system.hpp"
 #include "support/data.hpp"
 
 #include <catch2/catch.hpp>
+#include <opencv2/core.hpp>
 
 #include <random>
 
@@ -42,7 +43,7 @@ TEST_CASE("keypoint grid returns exactly the keypoints inside the window and lev
     kps[i].y = y(rng);
     kps[i].level = static_cast<int>(i % 8);
   }
-  const rgbl::KeypointGrid grid(kps, 640, 480);
+  const rgbl::FeatureGrid grid(kps, 640, 480);
   std::vector<int> out;
   for (int q = 0; q < 200; ++q) {
     const float qx = x(rng), qy = y(rng), r = 3.0F + static_cast<float>(q % 40);
@@ -92,10 +93,8 @@ TEST_CASE("system: configuration errors name the key; no depth keeps it uninitia
 TEST_CASE("seq 04 with LiDAR depth: every frame tracked, ATE <= 0.10 m, drift <= 0.8 %") {
   const auto sequence = rgbl::test::kitti_seq04();
   if (!sequence) return;
-  rgbl::dev::RunOptions options;
-  options.camera = 2;
-  const auto s = rgbl::dev::run_kitti_sequence(*sequence, options);
-  INFO("ATE " << s.ate_rmse << " m, drift " << s.drift_percent << " %, scale " << s.scale_ratio);
+  const auto s = rgbl::test::run_sequence(*sequence, 0, 51);
+  INFO("ATE " << s.ate_rmse << " m, drift " << s.drift_percent << " %");
   CHECK(s.frames == 51);
   CHECK(s.tracked == 51);
   CHECK(s.ate_rmse <= 0.10);
@@ -105,11 +104,8 @@ TEST_CASE("seq 04 with LiDAR depth: every frame tracked, ATE <= 0.10 m, drift <=
 TEST_CASE("deterministic mode: the same input gives a bit-identical trajectory") {
   const auto sequence = rgbl::test::kitti_seq04();
   if (!sequence) return;
-  rgbl::dev::RunOptions options;
-  options.camera = 0;
-  options.frames = 20;
-  const auto a = rgbl::dev::run_kitti_sequence(*sequence, options);
-  const auto b = rgbl::dev::run_kitti_sequence(*sequence, options);
+  const auto a = rgbl::test::run_sequence(*sequence, 2, 20);
+  const auto b = rgbl::test::run_sequence(*sequence, 2, 20);
   REQUIRE(a.estimate.size() == 20);
   REQUIRE(b.estimate.size() == 20);
   for (std::size_t i = 0; i < a.estimate.size(); ++i) {

@@ -41,10 +41,6 @@ class DepthErrorAccumulator {
 
 DepthErrors evaluate_depth(const cv::Mat_<float>& prediction, const cv::Mat_<float>& ground_truth);
 
-// KITTI odometry poses/NN.txt: one row-major 3x4 T_w_cam0 per line. Throws ParseError naming the
-// file and line.
-std::vector<Eigen::Isometry3d> read_kitti_poses(const std::filesystem::path& file);
-
 struct AccumulationOptions {
   int half_window = 5;           // scans center-k .. center+k (those that exist)
   bool include_center = false;   // false: only neighbours, so the input's own samples are not graded by themselves

@@ -1,6 +1,7 @@
 #pragma once
 // One tracked frame: keypoints, descriptors, depth per keypoint and a grid for radius queries.
 
+#include "rgbl/features/matcher.hpp"
 #include "rgbl/features/types.hpp"
 #include "rgbl/map/map.hpp"
 
@@ -20,23 +21,6 @@ namespace rgbl {
 using FeatureExtractor =
     std::function<void(const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors)>;
 
-// Buckets keypoints into square cells for "which keypoints lie within r of (x, y)" queries.
-class KeypointGrid {
- public:
-  KeypointGrid() = default;
-  KeypointGrid(std::span<const Keypoint> keypoints, int width, int height, int cell_size = 16);
-
-  // Indices of keypoints with |dx|, |dy| <= radius and level in [min_level, max_level] (max_level < 0:
-  // any level), appended to out after clearing it.
-  void query(float x, float y, float radius, int min_level, int max_level, std::vector<int>& out) const;
-
- private:
-  std::span<const Keypoint> keypoints_;
-  int cell_size_ = 16, columns_ = 0, rows_ = 0;
-  std::vector<int> cell_start_;  // CSR layout: indices_[cell_start_[c] .. cell_start_[c+1])
-  std::vector<int> indices_;
-};
-
 struct Frame {
   std::size_t index = 0;
   double timestamp = 0.0;
@@ -47,10 +31,10 @@ struct Frame {
   std::vector<LandmarkId> landmarks;
   std::vector<bool> outlier;
   Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();
-  KeypointGrid grid;  // refers to keypoints: rebuild after copying or moving the frame
+  FeatureGrid grid;  // radius queries over keypoints; rebuild after changing them
 
   std::size_t size() const { return keypoints.size(); }
-  void build_grid(int width, int height) { grid = KeypointGrid(keypoints, width, height); }
+  void build_grid(int width, int height) { grid = FeatureGrid(keypoints, width, height); }
 };
 
 }  // namespace rgbl

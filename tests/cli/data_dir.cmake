@@ -1,0 +1,16 @@
+# Sets `data` to the real-data folder ($RGBL_DATA_DIR, else DATA_DIR), or reports the skip and returns
+# from the including script (fails instead when RGBL_REQUIRE_DATA=1, as in CI).
+macro(rgbl_find_data relative)
+  if(DEFINED ENV{RGBL_DATA_DIR} AND NOT "$ENV{RGBL_DATA_DIR}" STREQUAL "")
+    set(data $ENV{RGBL_DATA_DIR}/${relative})
+  else()
+    set(data ${DATA_DIR}/${relative})
+  endif()
+  if(NOT EXISTS ${data})
+    if("$ENV{RGBL_REQUIRE_DATA}" STREQUAL "1")
+      message(FATAL_ERROR "RGBL_REQUIRE_DATA=1 but ${data} does not exist")
+    endif()
+    message("skipped: no data (${data} not found)")
+    return()
+  endif()
+endmacro()
