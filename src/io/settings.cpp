@@ -120,6 +120,24 @@ Settings read_settings(const std::filesystem::path& yaml) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
     throw ParseError(yaml, 0, "is empty (expected 'Key: value' settings)");
   }
+  // OpenCV 4.6's YAML parser loops forever on some lines starting with "---" (found by fuzz_settings:
+  // "----s\n----\nL"). A settings file is one document: allow a single plain "---" line, nothing else.
+  {
+    std::size_t line_no = 0, markers = 0, pos = 0;
+    while (pos < text.size()) {
+      const std::size_t end = std::min(text.find('\n', pos), text.size());
+      std::string_view line(text.data() + pos, end - pos);
+      ++line_no;
+      if (line.starts_with("---")) {
+        while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.remove_suffix(1);
+        if (line != "---" || ++markers > 1) {
+          throw ParseError(yaml, line_no, "expected 'Key: value' (a settings file is one YAML document; '---' "
+                                          "may only start it)");
+        }
+      }
+      pos = end + 1;
+    }
+  }
   if (!text.starts_with("%YAML")) text = "%YAML:1.0\n" + text;
   cv::FileStorage storage;
   try {
