@@ -1,14 +1,55 @@
 #!/usr/bin/env bash
 # Runs the test suite under AddressSanitizer + UndefinedBehaviorSanitizer (preset asan), and the
-# threaded-mapping tests under ThreadSanitizer (preset tsan) when they exist.
+# threaded-mapping tests (label `threaded`) under ThreadSanitizer (preset tsan).
+#
+# Two things have made TSan binaries crash at start-up (SIGSEGV before main):
+# - ifunc resolvers instrumented by GCC (target_clones in src/depth/completion.cpp): the loader runs
+#   them before the TSan runtime exists. Fixed in the code: no clones when __SANITIZE_THREAD__.
+# - kernels that randomise mmap addresses with more than 28 bits (vm.mmap_rnd_bits = 32) collide with
+#   TSan's fixed shadow layout. We lower the sysctl to 28 when we may (root), restore it on exit, and
+#   skip TSan with a clear message only when a minimal TSan probe still crashes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
 export CTEST_PARALLEL_LEVEL="${CTEST_PARALLEL_LEVEL:-$(nproc)}"
 export CMAKE_BUILD_PARALLEL_LEVEL="${CMAKE_BUILD_PARALLEL_LEVEL:-$(nproc)}"
 cmake --workflow --preset asan
-if [ -d tests/tracking ]; then
-  cmake --preset tsan
-  cmake --build --preset tsan --target test_tracking
-  ctest --preset tsan -L threaded
+
+rnd_bits_file=/proc/sys/vm/mmap_rnd_bits
+original_bits=""
+restore_bits() {
+  if [ -n "$original_bits" ]; then echo "$original_bits" > "$rnd_bits_file" 2>/dev/null || true; fi
+}
+trap restore_bits EXIT
+
+# Does a TSan binary start here? (built once, a few lines of C++)
+tsan_works() {
+  local dir; dir="$(mktemp -d)"
+  printf '#include <thread>\nint v; int main() { std::thread t([] { v = 1; }); t.join(); return v - 1; }\n' \
+    > "$dir/probe.cpp"
+  local ok=1
+  if "${CXX:-c++}" -fsanitize=thread "$dir/probe.cpp" -o "$dir/probe" 2> "$dir/log" && "$dir/probe" >> "$dir/log" 2>&1; then
+    ok=0
+  fi
+  rm -rf "$dir"
+  return $ok
+}
+
+bits="$(cat "$rnd_bits_file" 2>/dev/null || echo 0)"
+if [ "$bits" -gt 28 ]; then
+  if echo 28 2>/dev/null > "$rnd_bits_file"; then
+    original_bits="$bits"
+    echo "sanitize: vm.mmap_rnd_bits lowered from $bits to 28 for ThreadSanitizer (restored on exit)"
+  else
+    echo "sanitize: vm.mmap_rnd_bits is $bits and not writable here (needs root: sysctl -w vm.mmap_rnd_bits=28)"
+  fi
 fi
+if ! tsan_works; then
+  echo "sanitize: SKIPPING ThreadSanitizer: a minimal TSan binary crashes on this machine" \
+       "(vm.mmap_rnd_bits=$(cat "$rnd_bits_file" 2>/dev/null || echo '?'); TSan needs <= 28)." >&2
+  echo "sanitize: ASan + UBSan passed; the threaded tests were NOT checked for data races." >&2
+  exit 0
+fi
+cmake --preset tsan
+cmake --build --preset tsan --target test_threaded
+ctest --preset tsan

@@ -6,7 +6,9 @@
 
 #include <fmt/format.h>
 
+#include <charconv>
 #include <cmath>
+#include <system_error>
 
 namespace rgbl::cli {
 namespace {
@@ -34,7 +36,15 @@ void apply_depth_spec(const std::string& spec, Pipeline& p) {
                                                  spec));
       }
       lidar.dilation.shape = parse_kernel_shape(arg.substr(0, digit), "--depth");
-      lidar.dilation.size = std::stoi(arg.substr(digit));
+      // std::stoi would accept "7x" and throw a bare "stoi" on overflow: parse the whole tail.
+      const std::string size = arg.substr(digit);
+      int value = 0;
+      const auto [end, ec] = std::from_chars(size.data(), size.data() + size.size(), value);
+      if (ec != std::errc() || end != size.data() + size.size() || value < 1 || value > 63 || value % 2 == 0) {
+        throw ConfigError("--depth", fmt::format("an odd kernel size 1..63 after the shape (e.g. lidar:diamond5), "
+                                                 "not '{}'", spec));
+      }
+      lidar.dilation.size = value;
     }
   } else if (name == "precomputed") {
     if (arg.empty()) throw ConfigError("--depth", "precomputed:<folder of uint16 depth PNGs>");
@@ -47,7 +57,7 @@ void apply_depth_spec(const std::string& spec, Pipeline& p) {
 }
 
 void apply_settings(const Settings& s, Pipeline& p) {
-  for (const auto& w : s.warnings) p.notes.push_back(fmt::format("{}: {}", s.file.string(), w));
+  for (const auto& w : s.warnings) p.notes.push_back(w);  // each already names the file
   p.orb.num_features = s.orb.n_features;
   p.orb.num_levels = s.orb.n_levels;
   p.orb.scale_factor = static_cast<float>(s.orb.scale_factor);
@@ -122,7 +132,14 @@ Pipeline make_pipeline(const InputOptions& options) {
     p.depth_settings.stereo_baseline = kitti.baseline(p.camera, p.camera + 1);
   }
   apply_depth_spec(options.depth, p);
-  if (!options.config.empty()) apply_settings(read_settings(options.config), p);
+  if (!options.config.empty()) {
+    const Settings settings = read_settings(options.config);
+    try {
+      apply_settings(settings, p);
+    } catch (const ConfigError& e) {
+      throw ParseError(settings.file, 0, e.what());  // name the settings file, not just the key
+    }
+  }
   p.depth_settings.calibration = p.calibration;
 
   if (p.depth_name == "lidar" && !sensors.lidar) {

@@ -21,6 +21,7 @@
 #include <memory>
 #include <mutex>
 #include <shared_mutex>
+#include <system_error>
 #include <vector>
 
 namespace rgbl::cli {
@@ -74,6 +75,16 @@ KittiMetricOptions kitti_lengths_for(double path_length, std::string& descriptio
   return options;
 }
 
+// Outputs of an earlier run in the same folder would look like this run's if it fails: remove them
+// before anything can fail (a successful run overwrites them anyway).
+void remove_previous_outputs(const std::filesystem::path& out_dir) {
+  for (const char* name : {"trajectory_kitti.txt", "trajectory_tum.txt", "timing.csv", "summary.json",
+                           "trajectory.svg", "map.ply"}) {
+    std::error_code ec;
+    std::filesystem::remove(out_dir / name, ec);
+  }
+}
+
 struct FrameRecord {
   TrackResult result;
   double io_wait_ms = 0.0;
@@ -83,6 +94,7 @@ struct FrameRecord {
 
 RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool threaded, bool quiet) {
   std::filesystem::create_directories(out_dir);
+  remove_previous_outputs(out_dir);
   SystemOptions system_options = p.system;
   system_options.threaded_mapping = threaded;
   System system(system_options, p.calibration, p.make_depth_source(), p.make_extractor());
@@ -304,6 +316,7 @@ Command add_run_command(CLI::App& parent) {
   app->add_option("--out", *out_dir, "Output folder")->capture_default_str();
   app->add_flag("--threaded", *threaded, "Local mapping in its own thread (default: inline, bit-for-bit reproducible)");
   return {app, [options, out_dir, threaded, app] {
+            remove_previous_outputs(*out_dir);
             Pipeline pipeline = make_pipeline(*options);
             const bool quiet = app->get_parent()->get_option("--quiet")->as<bool>();
             for (const auto& note : pipeline.notes) fmt::print(stderr, "note: {}\n", note);

@@ -12,8 +12,10 @@
 #include <limits>
 
 // Run-time selection of AVX2 (x86-64-v3) / AVX-512 (x86-64-v4) builds of the hot loops, with a plain
-// baseline for other CPUs. GCC on x86-64 only; elsewhere the portable code is compiled once.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+// baseline for other CPUs. GCC on x86-64 only; elsewhere the portable code is compiled once. Not
+// under ThreadSanitizer: GCC instruments the ifunc resolvers, which the dynamic loader runs before
+// the TSan runtime is initialised, so every binary linking this file crashed at start-up.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_THREAD__)
 #define RGBL_CLONES_AVX2 __attribute__((target_clones("arch=x86-64-v3", "default")))
 #define RGBL_CLONES_AVX512 __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else

@@ -133,13 +133,10 @@ class LidarDepthSource final : public DepthSource {
 
   void prepare(const SensorFrame& frame) override {
     // An empty scan is a LiDAR dropout, not a misconfiguration (a dataset without scans is refused
-    // where the source is chosen): the frame simply has no depth, and the tracker copes with that.
+    // where the source is chosen): the projection leaves the frame without depth, and the tracker
+    // copes with that.
     sparse_.create(camera_.height, camera_.width);
-    if (frame.scan.empty()) {
-      sparse_.setTo(0.0F);
-    } else {
-      project_to_depth(frame.scan, P_img_lidar_, options_.projection, sparse_);
-    }
+    project_to_depth(frame.scan, P_img_lidar_, options_.projection, sparse_);
     dense_.release();
     if (options_.completion != CompletionMethod::dilation) dense_ = complete();
   }

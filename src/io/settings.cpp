@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <fstream>
 #include <iterator>
 #include <set>
@@ -119,6 +120,24 @@ Settings read_settings(const std::filesystem::path& yaml) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
     throw ParseError(yaml, 0, "is empty (expected 'Key: value' settings)");
   }
+  // OpenCV 4.6's YAML parser loops forever on some lines starting with "---" (found by fuzz_settings:
+  // "----s\n----\nL"). A settings file is one document: allow a single plain "---" line, nothing else.
+  {
+    std::size_t line_no = 0, markers = 0, pos = 0;
+    while (pos < text.size()) {
+      const std::size_t end = std::min(text.find('\n', pos), text.size());
+      std::string_view line(text.data() + pos, end - pos);
+      ++line_no;
+      if (line.starts_with("---")) {
+        while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.remove_suffix(1);
+        if (line != "---" || ++markers > 1) {
+          throw ParseError(yaml, line_no, "expected 'Key: value' (a settings file is one YAML document; '---' "
+                                          "may only start it)");
+        }
+      }
+      pos = end + 1;
+    }
+  }
   if (!text.starts_with("%YAML")) text = "%YAML:1.0\n" + text;
   cv::FileStorage storage;
   try {
@@ -126,6 +145,10 @@ Settings read_settings(const std::filesystem::path& yaml) {
   } catch (const cv::Exception& e) {
     throw ParseError(yaml, 0,
                      fmt::format("not a readable YAML settings file: expected 'Key: value' lines (OpenCV: {})", e.err));
+  } catch (const std::exception&) {
+    // OpenCV 4.6's parser lets standard exceptions escape on some malformed input (found by
+    // fuzz_settings: std::length_error on a map with an empty key, `a: { : { b: 1 "x" }`).
+    throw ParseError(yaml, 0, "not a readable YAML settings file: expected 'Key: value' lines (OpenCV's parser failed)");
   }
   if (!storage.isOpened())
     throw ParseError(yaml, 0, "cannot open (expected an ORB-SLAM style %YAML:1.0 settings file)");

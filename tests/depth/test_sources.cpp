@@ -79,12 +79,16 @@ TEST_CASE("lidar source: projects, samples keypoints and agrees with its dense m
   const auto registry = rgbl::DepthSourceRegistry::with_builtins();
   auto source = registry.create("lidar", simple_settings());
   CHECK(source->name() == "lidar");
-  // an empty scan (a dropout) is a frame without depth, not an error
-  source->prepare({});
-  std::vector<rgbl::KeypointDepth> none(1);
-  source->sample(std::vector<Eigen::Vector2f>{{33.0F, 24.0F}}, none);
-  CHECK(none[0].z == 0.0F);
-  CHECK(cv::countNonZero(source->dense_depth()) == 0);
+  {
+    // A dropped scan (empty) is no depth anywhere, not an error that would stop a run.
+    source->prepare({});
+    const std::vector<Eigen::Vector2f> anywhere = {{32.0F, 24.0F}, {5.0F, 5.0F}};
+    std::vector<rgbl::KeypointDepth> none(anywhere.size(), rgbl::KeypointDepth{7.0F});
+    source->sample(anywhere, none);
+    CHECK(none[0].z == 0.0F);
+    CHECK(none[1].z == 0.0F);
+    CHECK(cv::countNonZero(source->dense_depth()) == 0);
+  }
   const std::vector<rgbl::LidarPoint> scan = {{0.0F, 0.0F, 10.0F, 0.0F}, {0.3F, 0.0F, 20.0F, 0.0F}};  // (32,24), (33.5->34,24)
   rgbl::SensorFrame frame;
   frame.scan = scan;

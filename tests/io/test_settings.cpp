@@ -153,3 +153,16 @@ TEST_CASE("settings: wrong types, incomplete groups and bad values name file and
   CHECK_THAT(error_of(tmp.path() / "missing.yaml"), Contains("missing"));
   CHECK_THAT(error_of(tmp.path()), Contains("not a file"));
 }
+
+TEST_CASE("settings: input on which OpenCV's parser throws standard exceptions is a ParseError", "[io][settings][bad-input]") {
+  // Found by fuzz/fuzz_settings: OpenCV 4.6 let std::length_error escape FileStorage::open here.
+  rgbl::test::TempDir tmp;
+  const auto file = tmp.write("empty_key.yaml", "FrameSize: 0.05\nUnknown.key: [1, 2, 3]\nNested: { : { a: 1 \"x\" }\n");
+  CHECK_THAT(error_of(file), Contains("empty_key.yaml") && Contains("not a readable YAML settings file"));
+  CHECK_THAT(error_of(tmp.write("nested.yaml", "a: { : { b: 1 \"x\" }\n")), Contains("nested.yaml"));
+  // Found by fuzz/fuzz_settings: OpenCV 4.6's parser never returned on this (document markers).
+  CHECK_THAT(error_of(tmp.write("markers.yaml", "----s\n----\nL")), Contains("markers.yaml:1: expected 'Key: value'"));
+  CHECK_THAT(error_of(tmp.write("two.yaml", "---\na: 1\n---\nb: 2\n")), Contains("two.yaml:3:"));
+  // One plain document start is fine.
+  CHECK(rgbl::read_settings(tmp.write("one.yaml", "%YAML:1.0\n---\nCamera.fps: 10.0\n")).fps == 10.0);
+}

@@ -1,0 +1,101 @@
+#pragma once
+// Runs the System (LiDAR depth, rgbl's ORB) on frames of the real KITTI excerpt with injected
+// failures: black images, dropped scans, jumps in the frame sequence. Header-only test support.
+#include "rgbl/core/error.hpp"
+#include "rgbl/depth/sources.hpp"
+#include "rgbl/features/orb.hpp"
+#include "rgbl/geometry/calibration.hpp"
+#include "rgbl/geometry/point_cloud.hpp"
+#include "rgbl/io/trajectory_io.hpp"
+#include "rgbl/tracking/system.hpp"
+
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace rgbl::test {
+
+struct Step {
+  std::size_t frame = 0;  // KITTI frame read from disk (also the SensorFrame index)
+  bool black = false;     // replace the image by zeros
+  bool drop_scan = false;
+};
+
+struct Outcome {
+  std::vector<rgbl::TrackResult> results;
+  std::vector<rgbl::TrajectoryPose> trajectory;
+  std::vector<Eigen::Isometry3d> truth;  // T_world_cam0 of the frames fed
+};
+
+inline Outcome run(const std::filesystem::path& sequence, const std::vector<Step>& steps, bool threaded = false) {
+  const auto name = [](std::size_t i) { return fmt::format("{:06}", i); };
+  const cv::Mat first = cv::imread((sequence / "image_0" / (name(0) + ".png")).string(), cv::IMREAD_GRAYSCALE);
+  const auto kitti = rgbl::read_kitti_odometry_calibration(sequence / "calib.txt", first.cols, first.rows);
+  rgbl::DepthSourceSettings depth;
+  depth.calibration = kitti.camera(0);
+  auto orb = std::make_shared<rgbl::OrbExtractor>();
+  rgbl::SystemOptions options;
+  options.threaded_mapping = threaded;
+  rgbl::System system(options, depth.calibration, rgbl::make_lidar_source(depth),
+                      [orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
+                        orb->extract(g, k, d);
+                      });
+  const auto poses = rgbl::read_kitti_trajectory(sequence.parent_path().parent_path() / "poses" /
+                                                 (sequence.filename().string() + ".txt"));
+  Outcome out;
+  std::vector<rgbl::LidarPoint> scan;
+  for (const Step& step : steps) {
+    rgbl::SensorFrame frame;
+    frame.index = step.frame;
+    frame.timestamp = 0.1 * static_cast<double>(step.frame);
+    frame.image = cv::imread((sequence / "image_0" / (name(step.frame) + ".png")).string(), cv::IMREAD_GRAYSCALE);
+    REQUIRE(!frame.image.empty());
+    if (step.black) frame.image = cv::Mat::zeros(frame.image.size(), CV_8UC1);
+    scan.clear();
+    if (!step.drop_scan) rgbl::read_kitti_scan(sequence / "velodyne" / (name(step.frame) + ".bin"), scan);
+    frame.scan = scan;
+    out.results.push_back(system.track(frame));
+    out.truth.push_back(poses.at(step.frame));
+  }
+  system.finish();
+  out.trajectory = system.trajectory();
+  return out;
+}
+
+inline std::vector<Step> frames(std::size_t first, std::size_t last) {
+  std::vector<Step> steps;
+  for (std::size_t i = first; i <= last; ++i) steps.push_back({i});
+  return steps;
+}
+
+// Every fed frame is in the trajectory, in order, with the state track() reported and a finite pose.
+inline void check_complete(const Outcome& o) {
+  REQUIRE(o.trajectory.size() == o.results.size());
+  for (std::size_t i = 0; i < o.results.size(); ++i) {
+    INFO("frame " << o.results[i].frame_index);
+    CHECK(o.trajectory[i].frame_index == o.results[i].frame_index);
+    CHECK(o.trajectory[i].state == o.results[i].state);
+    CHECK(o.trajectory[i].T_world_cam.matrix().allFinite());
+  }
+}
+
+inline std::string states(const Outcome& o) {
+  std::string s;
+  for (const auto& r : o.results) s += fmt::format("{}:{} ", r.frame_index, rgbl::to_string(r.state));
+  return s;
+}
+
+// Translation error of frame k relative to frame 0 against ground truth (both start at frame 0).
+inline double relative_error(const Outcome& o, std::size_t k) {
+  const Eigen::Isometry3d est = o.trajectory.front().T_world_cam.inverse() * o.trajectory[k].T_world_cam;
+  const Eigen::Isometry3d gt = o.truth.front().inverse() * o.truth[k];
+  return (est.translation() - gt.translation()).norm();
+}
+
+
+}  // namespace rgbl::test
