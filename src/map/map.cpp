@@ -275,6 +275,20 @@ std::vector<KeyframeId> Map::keyframe_ids() const {
   return ids;
 }
 
+std::vector<LandmarkId> Map::landmarks_seen_by(std::span<const KeyframeId> keyframes) const {
+  std::vector<LandmarkId> seen;
+  for (const KeyframeId id : keyframes) {
+    const Keyframe* kf = keyframe(id);
+    if (kf == nullptr) continue;
+    for (const LandmarkId l : kf->landmarks) {
+      if (l.valid()) seen.push_back(l);
+    }
+  }
+  std::sort(seen.begin(), seen.end());
+  seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+  return seen;
+}
+
 std::vector<LandmarkId> Map::landmark_ids() const {
   std::vector<LandmarkId> ids;
   ids.reserve(landmark_count_);

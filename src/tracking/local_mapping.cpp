@@ -167,17 +167,7 @@ int LocalMapper::fuse(KeyframeId id) {
     }
     for (const KeyframeId t : targets) fused += fuse_into(t, own);
   }
-  std::vector<LandmarkId> theirs;
-  for (const KeyframeId t : targets) {
-    const Keyframe* kf = map_.keyframe(t);
-    if (kf == nullptr) continue;
-    for (const LandmarkId l : kf->landmarks) {
-      if (l.valid()) theirs.push_back(l);
-    }
-  }
-  std::sort(theirs.begin(), theirs.end());
-  theirs.erase(std::unique(theirs.begin(), theirs.end()), theirs.end());
-  fused += fuse_into(id, theirs);
+  fused += fuse_into(id, map_.landmarks_seen_by(targets));
   if (const Keyframe* kf = map_.keyframe(id)) {
     for (const LandmarkId l : kf->landmarks) {
       if (l.valid()) map_.update_landmark(l);

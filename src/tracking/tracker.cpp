@@ -13,6 +13,23 @@
 
 namespace rgbl {
 
+namespace {
+
+// The frame's observations as a new keyframe (landmark links are added by the caller).
+Keyframe keyframe_from(const Frame& frame) {
+  Keyframe kf;
+  kf.frame_index = frame.index;
+  kf.timestamp = frame.timestamp;
+  kf.T_cam_world = frame.T_cam_world;
+  kf.keypoints = frame.keypoints;
+  kf.descriptors = frame.descriptors;
+  kf.depth = frame.depth;
+  kf.depth_sigma = frame.depth_sigma;
+  return kf;
+}
+
+}  // namespace
+
 const char* to_string(TrackState state) {
   switch (state) {
     case TrackState::NotInitialised: return "not_initialised";
@@ -125,15 +142,7 @@ bool Tracker::initialise(Frame& frame) {
   if (usable < options_.min_initial_depth_points) return false;
   frame.T_cam_world = Eigen::Isometry3d::Identity();
   std::unique_lock lock(map_.mutex());
-  Keyframe kf;
-  kf.frame_index = frame.index;
-  kf.timestamp = frame.timestamp;
-  kf.T_cam_world = frame.T_cam_world;
-  kf.keypoints = frame.keypoints;
-  kf.descriptors = frame.descriptors;
-  kf.depth = frame.depth;
-  kf.depth_sigma = frame.depth_sigma;
-  const KeyframeId id = map_.add_keyframe(std::move(kf));
+  const KeyframeId id = map_.add_keyframe(keyframe_from(frame));
   const Eigen::Isometry3d T_world_cam = frame.T_cam_world.inverse();
   for (std::size_t i = 0; i < frame.size(); ++i) {
     if (frame.depth_sigma[i] <= 0.0F) continue;
@@ -384,16 +393,7 @@ void Tracker::update_local_map(const Frame& frame) {
     }
   }
   if (!sorted.empty()) reference_ = sorted.front().second;
-  local_landmarks_.clear();
-  for (const KeyframeId id : local_keyframes_) {
-    const Keyframe* kf = map_.keyframe(id);
-    if (kf == nullptr) continue;
-    for (const LandmarkId l : kf->landmarks) {
-      if (l.valid()) local_landmarks_.push_back(l);
-    }
-  }
-  std::sort(local_landmarks_.begin(), local_landmarks_.end());
-  local_landmarks_.erase(std::unique(local_landmarks_.begin(), local_landmarks_.end()), local_landmarks_.end());
+  local_landmarks_ = map_.landmarks_seen_by(local_keyframes_);
 }
 
 bool Tracker::track_local_map(Frame& frame) {
@@ -540,15 +540,7 @@ bool Tracker::need_keyframe(const Frame& frame, int inliers, bool mapping_idle) 
 
 KeyframeId Tracker::make_keyframe(const Frame& frame) {
   std::unique_lock lock(map_.mutex());
-  Keyframe kf;
-  kf.frame_index = frame.index;
-  kf.timestamp = frame.timestamp;
-  kf.T_cam_world = frame.T_cam_world;
-  kf.keypoints = frame.keypoints;
-  kf.descriptors = frame.descriptors;
-  kf.depth = frame.depth;
-  kf.depth_sigma = frame.depth_sigma;
-  const KeyframeId id = map_.add_keyframe(std::move(kf));
+  const KeyframeId id = map_.add_keyframe(keyframe_from(frame));
   for (std::size_t i = 0; i < frame.size(); ++i) {
     if (frame.landmarks[i].valid() && !frame.outlier[i]) map_.add_observation(frame.landmarks[i], id, static_cast<int>(i));
   }

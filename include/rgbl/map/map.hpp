@@ -19,6 +19,7 @@
 #include <map>
 #include <optional>
 #include <shared_mutex>
+#include <span>
 #include <vector>
 
 namespace rgbl {
@@ -120,6 +121,8 @@ class Map {
   // Ids of the live keyframes / landmarks in increasing order.
   std::vector<KeyframeId> keyframe_ids() const;
   std::vector<LandmarkId> landmark_ids() const;
+  // The distinct landmarks observed by any of `keyframes` (erased keyframes are skipped), ascending.
+  std::vector<LandmarkId> landmarks_seen_by(std::span<const KeyframeId> keyframes) const;
   KeyframeId last_keyframe_id() const;
 
   void clear();
