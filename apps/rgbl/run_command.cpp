@@ -249,6 +249,10 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
     front_ms.push_back(t.depth_ms + t.extraction_ms + t.tracking_ms);
     io_ms.push_back(r.io_wait_ms);
   }
+  const auto depth = stats(depth_ms);
+  const auto extraction = stats(extraction_ms);
+  const auto tracking = stats(tracking_ms);
+  const auto mapping = stats(mapping_ms);
   const auto front = stats(front_ms);
   const auto total = stats(total_ms);
   out.median_front_ms = front.median;
@@ -276,8 +280,8 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
          << fmt::format("  \"threaded_mapping\": {},\n  \"wall_s\": {},\n", threaded ? "true" : "false",
                         json_number(out.wall_s))
          << "  \"stage_ms\": {\n    " << stage_json("io_wait", stats(io_ms)) << ",\n    "
-         << stage_json("depth", stats(depth_ms)) << ",\n    " << stage_json("extraction", stats(extraction_ms))
-         << ",\n    " << stage_json("tracking", stats(tracking_ms)) << ",\n    " << stage_json("mapping", stats(mapping_ms))
+         << stage_json("depth", depth) << ",\n    " << stage_json("extraction", extraction)
+         << ",\n    " << stage_json("tracking", tracking) << ",\n    " << stage_json("mapping", mapping)
          << ",\n    " << stage_json("depth_extraction_tracking", front) << ",\n    " << stage_json("total", total)
          << "\n  },\n"
          << "  \"metrics\": " << metrics_json << "\n}\n";
@@ -290,8 +294,8 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
              out.not_initialised, out.keyframes, out.landmarks);
   fmt::print("  per frame (median / p95 ms): depth {:.2f} / {:.2f}, extraction {:.2f} / {:.2f}, tracking {:.2f} / "
              "{:.2f}, mapping {:.2f} / {:.2f}\n",
-             stats(depth_ms).median, stats(depth_ms).p95, stats(extraction_ms).median, stats(extraction_ms).p95,
-             stats(tracking_ms).median, stats(tracking_ms).p95, stats(mapping_ms).median, stats(mapping_ms).p95);
+             depth.median, depth.p95, extraction.median, extraction.p95, tracking.median, tracking.p95,
+             mapping.median, mapping.p95);
   fmt::print("  depth+extraction+tracking {:.2f} ms median; total {:.2f} ms median, {:.2f} ms mean\n", front.median,
              total.median, total.mean);
   if (out.ate_rmse_m) {

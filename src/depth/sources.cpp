@@ -1,6 +1,7 @@
 #include "rgbl/depth/sources.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "source_checks.hpp"
 
 #include <fmt/format.h>
 #include <opencv2/calib3d.hpp>
@@ -99,13 +100,6 @@ void sample_dense_depth(const cv::Mat_<float>& dense, const Kernel& kernel, std:
 }
 
 namespace {
-
-void require_size(const cv::Mat& image, const PinholeCamera& camera, const char* what) {
-  if (image.cols != camera.width || image.rows != camera.height) {
-    throw ConfigError(what, fmt::format("an image of the camera's size {}x{} (got {}x{})", camera.width,
-                                        camera.height, image.cols, image.rows));
-  }
-}
 
 // Distance from `p` to the nearest non-zero pixel centre of `sparse` within `radius`; radius + 1 if none.
 float nearest_sample_distance(const cv::Mat_<float>& sparse, const Eigen::Vector2f& p, int radius) {
@@ -218,7 +212,7 @@ class StereoDepthSource final : public DenseDepthSource {
   explicit StereoDepthSource(const DepthSourceSettings& settings)
       : camera_(settings.calibration.camera), baseline_(settings.stereo_baseline), options_(settings.stereo) {
     options_.validate();
-    require(baseline_ > 0.0 && std::isfinite(baseline_), "stereo_baseline", "the stereo baseline in metres (> 0)");
+    detail::require_stereo_baseline(baseline_);
     const int area = options_.block_size * options_.block_size;
     matcher_ = cv::StereoSGBM::create(0, options_.num_disparities, options_.block_size, 8 * area, 32 * area, 1,
                                       0, options_.uniqueness_ratio, options_.speckle_window, options_.speckle_range,
@@ -231,9 +225,9 @@ class StereoDepthSource final : public DenseDepthSource {
     if (frame.image.empty() || frame.image_right.empty()) {
       throw ConfigError("frame.image_right", "a rectified stereo pair (image and image_right) for the stereo source");
     }
-    require_size(frame.image, camera_, "frame.image");
-    require_size(frame.image_right, camera_, "frame.image_right");
-    matcher_->compute(grey(frame.image), grey(frame.image_right), disparity_);
+    detail::require_camera_size(frame.image, camera_, "frame.image");
+    detail::require_camera_size(frame.image_right, camera_, "frame.image_right");
+    matcher_->compute(detail::grey_image(frame.image), detail::grey_image(frame.image_right), disparity_);
     depth_.create(disparity_.rows, disparity_.cols);
     const float fb = static_cast<float>(camera_.fx * baseline_);
     for (int y = 0; y < disparity_.rows; ++y) {
@@ -248,13 +242,6 @@ class StereoDepthSource final : public DenseDepthSource {
   }
 
  private:
-  static cv::Mat grey(const cv::Mat& image) {
-    if (image.channels() == 1) return image;
-    cv::Mat out;
-    cv::cvtColor(image, out, cv::COLOR_BGR2GRAY);
-    return out;
-  }
-
   PinholeCamera camera_;
   double baseline_;
   StereoSourceOptions options_;
@@ -273,7 +260,7 @@ class RgbdDepthSource final : public DenseDepthSource {
 
   void prepare(const SensorFrame& frame) override {
     if (frame.depth_image.empty()) throw ConfigError("frame.depth_image", "a depth image for the rgbd source");
-    require_size(frame.depth_image, camera_, "frame.depth_image");
+    detail::require_camera_size(frame.depth_image, camera_, "frame.depth_image");
     if (frame.depth_image.type() == CV_16UC1) {
       frame.depth_image.convertTo(depth_, CV_32F, 1.0 / options_.scale);
     } else if (frame.depth_image.type() == CV_32FC1) {

@@ -13,6 +13,7 @@
 
 #include "rgbl/core/error.hpp"
 #include "rgbl/depth/sources.hpp"
+#include "source_checks.hpp"
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define RGBL_CLONES_AVX2 __attribute__((target_clones("arch=x86-64-v3", "default")))
@@ -87,19 +88,12 @@ float texture(const cv::Mat& image, int x, int y, int half) {
   return static_cast<float>(sum) / static_cast<float>((2 * half + 1) * (2 * half));
 }
 
-cv::Mat grey(const cv::Mat& image) {
-  if (image.channels() == 1) return image;
-  cv::Mat out;
-  cv::cvtColor(image, out, cv::COLOR_BGR2GRAY);
-  return out;
-}
-
 class StereoSparseDepthSource final : public DepthSource {
  public:
   explicit StereoSparseDepthSource(const DepthSourceSettings& settings)
       : camera_(settings.calibration.camera), baseline_(settings.stereo_baseline), options_(settings.stereo_sparse) {
     options_.validate();
-    require(baseline_ > 0.0 && std::isfinite(baseline_), "stereo_baseline", "the stereo baseline in metres (> 0)");
+    detail::require_stereo_baseline(baseline_);
     fb_ = static_cast<float>(camera_.fx * baseline_);
   }
 
@@ -110,10 +104,10 @@ class StereoSparseDepthSource final : public DepthSource {
       throw ConfigError("frame.image_right",
                         "a rectified stereo pair (image and image_right) for the stereo_sparse source");
     }
-    check_size(frame.image, "frame.image");
-    check_size(frame.image_right, "frame.image_right");
-    left_ = grey(frame.image);
-    right_ = grey(frame.image_right);
+    detail::require_camera_size(frame.image, camera_, "frame.image");
+    detail::require_camera_size(frame.image_right, camera_, "frame.image_right");
+    left_ = detail::grey_image(frame.image);
+    right_ = detail::grey_image(frame.image_right);
     if (left_.depth() != CV_8U || right_.depth() != CV_8U) {
       throw ConfigError("frame.image", "8-bit images (CV_8UC1 or CV_8UC3) for the stereo_sparse source");
     }
@@ -147,13 +141,6 @@ class StereoSparseDepthSource final : public DepthSource {
   }
 
  private:
-  void check_size(const cv::Mat& image, const char* key) const {
-    if (image.cols != camera_.width || image.rows != camera_.height) {
-      throw ConfigError(key, fmt::format("an image of the camera's size {}x{} (got {}x{})", camera_.width,
-                                         camera_.height, image.cols, image.rows));
-    }
-  }
-
   // Left-right check on the half level: the right window at xr (matched at disparity dc) searched
   // along the left row must come back to within 1 px of dc (occlusions and wrong matches do not).
   bool consistent(int xr, int y, int half, int dc, std::vector<std::uint16_t>& cost) const {

@@ -2,25 +2,17 @@
 #include "rgbl/backend/depth_noise.hpp"
 #include "rgbl/backend/pose_optimizer.hpp"
 
+#include "kitti_camera.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <random>
 
 namespace {
 
-rgbl::PinholeCamera kitti_camera() {
-  rgbl::PinholeCamera c;
-  c.fx = c.fy = 707.0912;
-  c.cx = 601.8873;
-  c.cy = 183.1104;
-  c.width = 1226;
-  c.height = 370;
-  return c;
-}
-
 // Points in front of the camera at T_cam_world, 5..40 m deep, spread over the image.
 std::vector<Eigen::Vector3d> scene(std::mt19937& rng, const Eigen::Isometry3d& T_cam_world, int n) {
-  const rgbl::PinholeCamera cam = kitti_camera();
+  const rgbl::PinholeCamera cam = rgbl::test::kitti_camera();
   std::uniform_real_distribution<double> u(0.0, cam.width - 1.0), v(0.0, cam.height - 1.0), z(5.0, 40.0);
   std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < n; ++i) {
@@ -38,7 +30,7 @@ Eigen::Isometry3d test_pose() {
 }  // namespace
 
 TEST_CASE("pose residual Jacobian matches numeric differentiation") {
-  const auto cam = kitti_camera();
+  const auto cam = rgbl::test::kitti_camera();
   const Eigen::Isometry3d T = test_pose();
   std::mt19937 rng(1);
   const auto points = scene(rng, T, 20);
@@ -73,7 +65,7 @@ TEST_CASE("pose residual Jacobian matches numeric differentiation") {
 }
 
 TEST_CASE("pose optimisation recovers a known pose with noise and flags the outliers") {
-  const auto cam = kitti_camera();
+  const auto cam = rgbl::test::kitti_camera();
   const Eigen::Isometry3d T_true = test_pose();
   std::mt19937 rng(2);
   const auto points = scene(rng, T_true, 300);

@@ -1,20 +1,12 @@
 #include "rgbl/backend/bundle_adjustment.hpp"
 
+#include "kitti_camera.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <random>
 
 namespace {
-
-rgbl::PinholeCamera camera() {
-  rgbl::PinholeCamera c;
-  c.fx = c.fy = 707.0912;
-  c.cx = 601.8873;
-  c.cy = 183.1104;
-  c.width = 1226;
-  c.height = 370;
-  return c;
-}
 
 Eigen::Isometry3d pose_along_road(double z) {
   rgbl::Vector6d xi;
@@ -25,7 +17,7 @@ Eigen::Isometry3d pose_along_road(double z) {
 }  // namespace
 
 TEST_CASE("bundle residual Jacobians match numeric differentiation") {
-  const auto cam = camera();
+  const auto cam = rgbl::test::kitti_camera();
   const Eigen::Isometry3d T = pose_along_road(3.0);
   const Eigen::Vector3d p = T.inverse() * Eigen::Vector3d(2.0, -1.0, 15.0);
   for (const bool with_depth : {false, true}) {
@@ -72,7 +64,7 @@ TEST_CASE("bundle residual Jacobians match numeric differentiation") {
 }
 
 TEST_CASE("local bundle adjustment recovers poses and points, keeps fixed poses, flags outliers") {
-  const auto cam = camera();
+  const auto cam = rgbl::test::kitti_camera();
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(20.0, cam.width - 20.0), v(20.0, cam.height - 20.0), z(6.0, 30.0);
   std::normal_distribution<double> noise(0.0, 0.5), pose_noise(0.0, 0.05), point_noise(0.0, 0.2);
@@ -133,7 +125,7 @@ TEST_CASE("local bundle adjustment recovers poses and points, keeps fixed poses,
 }
 
 TEST_CASE("bundle adjustment stops when the abort flag is set") {
-  const auto cam = camera();
+  const auto cam = rgbl::test::kitti_camera();
   rgbl::BundleProblem problem;
   problem.poses = {{pose_along_road(0.0), true}, {pose_along_road(1.0), false}};
   for (int i = 0; i < 50; ++i) {
