@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 // Run-time selection of AVX2 (x86-64-v3) / AVX-512 (x86-64-v4) builds of the hot loops, with a plain
 // baseline for other CPUs. GCC on x86-64 only; elsewhere the portable code is compiled once. Not
@@ -17,10 +18,9 @@
 // the TSan runtime is initialised, so every binary linking this file crashed at start-up.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_THREAD__)
 #define RGBL_CLONES_AVX2 __attribute__((target_clones("arch=x86-64-v3", "default")))
-#define RGBL_CLONES_AVX512 __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#define RGBL_X86_DISPATCH 1
 #else
 #define RGBL_CLONES_AVX2
-#define RGBL_CLONES_AVX512
 #endif
 
 namespace rgbl {
@@ -104,6 +104,7 @@ struct Inversion {
 // inverted smallest depth.
 using Keys = std::int32_t __attribute__((vector_size(32)));
 using Floats = float __attribute__((vector_size(32)));
+using KeysU = std::uint32_t __attribute__((vector_size(32)));
 constexpr int kLanes = 8;
 constexpr std::int32_t kEmpty = 0x7F800000;  // +inf
 
@@ -273,86 +274,169 @@ RGBL_CLONES_AVX2 void combine_rows(const std::int32_t* const* sources, int count
   }
 }
 
-// The default 5x5 diamond, G output rows per pass over the key rows y-2 .. y+G+1: the row runs (widths
-// 1, 3, 5) are built in registers and shared between the outputs, so nothing but the output is stored
-// (6 loads per output vector for G = 8, instead of 11 loads and 4 stores through level rows). The
-// AVX-512 clone is kept for its 32 registers: about 7% faster on Zen 4 with G = 8 (no gain elsewhere).
-[[gnu::always_inline]] inline Keys min3(const std::int32_t* k, int x) {
-  return vmin(vmin(load(k + x - 1), load(k + x)), load(k + x + 1));
+// The default 5x5 diamond, fused: it reads the float depth rows directly, with no conversion pass and
+// no key rows. The key of a depth is its bit pattern minus lowest_key, as an unsigned number: the
+// depths the reference keeps map to [0, span) in depth order, and everything else (0, tiny, >= M,
+// negative, NaN) wraps or lands at >= span, so an unsigned min picks the nearest kept depth whenever
+// there is one. Keys are held with the sign bit flipped, so signed vector compares give unsigned
+// order (GCC 12 scalarises unsigned compare-and-select on 512-bit vectors). G output rows per pass
+// share the row runs (widths 1, 3, 5) built in registers. S is the key vector: 8 lanes (AVX2 or
+// baseline) or 16 (AVX-512, whose 32 registers hold a pass's 30 runs). Fusing removed a conversion
+// pass that took a third of the time.
+constexpr int kDiamondGroup = 8;  // output rows per pass (4: 7% slower, 16: spills)
+constexpr int kMaxLanes = 16;
+
+using Keys16 = std::int32_t __attribute__((vector_size(64)));
+using Keys16U = std::uint32_t __attribute__((vector_size(64)));
+using Floats16 = float __attribute__((vector_size(64)));
+
+struct DiamondBlock {
+  const float* in;          // input row y - 2 (G + 4 rows are read)
+  std::ptrdiff_t in_step;   // floats between input rows
+  float* out;               // output row y (G rows are written)
+  std::ptrdiff_t out_step;  // floats between output rows
+  int x0, x1;               // output columns; input columns [x0 - 2, x1 + 2 + lanes) must be readable
+  std::uint32_t lo, span;   // key = bits - lo; kept depths have key < span
+  float m, threshold;
+};
+
+// a + b with wrap-around (two's complement), for vectors of int32.
+template <class S>
+[[gnu::always_inline]] inline S wrap_add(S a, std::uint32_t b) {
+  using U = std::conditional_t<sizeof(S) == sizeof(Keys), KeysU, Keys16U>;
+  return std::bit_cast<S>(std::bit_cast<U>(a) + b);
+}
+template <class S>
+[[gnu::always_inline]] inline S load_keys(const float* p, std::uint32_t offset) {
+  S v;
+  std::memcpy(&v, p, sizeof(v));
+  return wrap_add(v, offset);
+}
+template <class S>
+[[gnu::always_inline]] inline S smin(S a, S b) {
+  return a < b ? a : b;
 }
 
-template <int G>
-[[gnu::always_inline]] inline void diamond5_group(const std::int32_t* const* k, float* const* out, int width, float m,
-                                                  float threshold) {
-  const Floats vm = Floats{} + m, vt = Floats{} + threshold, zero{};
-  const std::int32_t* rows[G + 4];
-  for (int i = 0; i < G + 4; ++i) rows[i] = k[i];
-  // The key rows are padded with +inf well past the last vector, so the loop may run over the end of
-  // the image; only the output needs a partial store.
-  for (int x = 0; x < width; x += kLanes) {
-    Keys l0[G + 4], l1[G + 4], l2[G + 4];
+template <class S>
+[[gnu::always_inline]] inline void diamond5_block(const DiamondBlock& b) {
+  constexpr int G = kDiamondGroup;
+  using F = std::conditional_t<sizeof(S) == sizeof(Floats), Floats, Floats16>;
+  constexpr int lanes = static_cast<int>(sizeof(S) / sizeof(std::int32_t));
+  constexpr std::uint32_t kSign = 0x80000000U;
+  const std::uint32_t offset = kSign - b.lo;  // bits + offset = (bits - lo) ^ sign
+  const S vspan = S{} + std::bit_cast<std::int32_t>(b.span ^ kSign);
+  const S vt = S{} + std::bit_cast<std::int32_t>(b.threshold);
+  const F vm = F{} + b.m;
+  for (int x = b.x0; x < b.x1; x += lanes) {
+    S l0[G + 4], l1[G + 4], l2[G + 4];
     for (int i = 0; i < G + 4; ++i) {
-      l0[i] = load(rows[i] + x);
-      if (i >= 1 && i <= G + 2) l1[i] = vmin(l0[i], vmin(load(rows[i] + x - 1), load(rows[i] + x + 1)));
-      if (i >= 2 && i <= G + 1) l2[i] = vmin(l1[i], vmin(load(rows[i] + x - 2), load(rows[i] + x + 2)));
+      const float* row = b.in + i * b.in_step + x;
+      l0[i] = load_keys<S>(row, offset);
+      if (i >= 1 && i <= G + 2) l1[i] = smin(l0[i], smin(load_keys<S>(row - 1, offset), load_keys<S>(row + 1, offset)));
+      if (i >= 2 && i <= G + 1) l2[i] = smin(l1[i], smin(load_keys<S>(row - 2, offset), load_keys<S>(row + 2, offset)));
     }
-    const int n = std::min(kLanes, width - x);
+    const int n = std::min(lanes, b.x1 - x);
     for (int j = 0; j < G; ++j) {
-      if (out[j] == nullptr) continue;
-      const Keys key = vmin(vmin(vmin(l0[j], l1[j + 1]), vmin(l2[j + 2], l1[j + 3])), l0[j + 4]);
-      const Floats d = vm - (vm - std::bit_cast<Floats>(key));  // +inf -> M - (-inf) = +inf -> 0 below
-      const Floats result = d > vt ? zero : d;
-      if (n == kLanes) {
-        store(out[j] + x, result);
+      // Capping the key at span turns "nothing kept" into M itself, which the threshold then zeroes.
+      const S key = smin(smin(smin(smin(l0[j], l1[j + 1]), smin(l2[j + 2], l1[j + 3])), l0[j + 4]), vspan);
+      const F back = vm - (vm - std::bit_cast<F>(wrap_add(key, 0U - offset)));  // the reference's rounding
+      // Zero unless it rounds below M (an integer compare: the result is >= 0, so bit order is value order).
+      const S bits = std::bit_cast<S>(back);
+      const S result = bits <= vt ? bits : S{};
+      float* dst = b.out + j * b.out_step + x;
+      if (n == lanes) {
+        std::memcpy(dst, &result, sizeof(result));
       } else {
-        std::memcpy(out[j] + x, &result, sizeof(float) * static_cast<std::size_t>(n));
+        std::memcpy(dst, &result, sizeof(float) * static_cast<std::size_t>(n));
       }
     }
   }
 }
 
-constexpr int kDiamondGroup = 8;  // output rows per pass (4: 7% slower, 16: spills)
+RGBL_CLONES_AVX2 void diamond5_avx2(const DiamondBlock& b) { diamond5_block<Keys>(b); }
 
-RGBL_CLONES_AVX512 void diamond5_rows(const std::int32_t* const* k, float* const* out, int width, float m,
-                                      float threshold) {
-  diamond5_group<kDiamondGroup>(k, out, width, m, threshold);
+#if defined(RGBL_X86_DISPATCH)
+__attribute__((target("arch=x86-64-v4"))) void diamond5_avx512(const DiamondBlock& b) { diamond5_block<Keys16>(b); }
+#endif
+
+// The widest build the CPU runs (a cached CPUID bit, nothing next to a block).
+void diamond5(const DiamondBlock& b) {
+#if defined(RGBL_X86_DISPATCH)
+  if (__builtin_cpu_supports("x86-64-v4")) return diamond5_avx512(b);
+#endif
+  diamond5_avx2(b);
 }
 
 void dilate_diamond5(const cv::Mat_<float>& sparse, const Inversion& inv, std::int32_t lo, std::int32_t hi,
                      cv::Mat_<float>& dense) {
+  constexpr int G = kDiamondGroup;
   const int width = sparse.cols, height = sparse.rows;
-  // Key rows y-2 .. y+G+1 in a ring, and one +inf row standing in for empty rows and rows outside the
-  // image (the last slot, never written).
-  constexpr int kLive = kDiamondGroup + 4;
-  constexpr int kRing = kLive + 1;
-  RowRing ring(width, kRing + 1, 1);
-  const std::int32_t* const empty = ring.row(kRing, 0);
-  std::vector<std::uint8_t> row_valid(static_cast<std::size_t>(height), 0);
-  int next_row = 0;
-  const std::int32_t* rows[kLive];
-  float* out[kDiamondGroup];
-  for (int y = 0; y < height; y += kDiamondGroup) {
-    // (no separate emptiness scan here: converting an empty row costs about as much as scanning it)
-    for (; next_row <= std::min(y + kDiamondGroup + 1, height - 1); ++next_row) {
-      std::int32_t* slot = ring.row(next_row % kRing, 0);
-      const bool valid = key_row(sparse[next_row], slot, width, lo, hi);
-      row_valid[static_cast<std::size_t>(next_row)] = valid ? 1 : 0;
-    }
-    bool any = false;
-    for (int i = 0; i < kLive; ++i) {
+  DiamondBlock block{};
+  block.lo = static_cast<std::uint32_t>(lo);
+  block.span = static_cast<std::uint32_t>(hi) - static_cast<std::uint32_t>(lo);
+  block.m = inv.m;
+  block.threshold = inv.threshold;
+
+  // Columns the passes read in place: every load of [x - 2, x + lanes + 2) stays inside the row.
+  const int xa = kMaxLanes;
+  const int xb = width - 2 > xa ? xa + (width - 2 - xa) / kMaxLanes * kMaxLanes : xa;
+  // Everything else (the image's first and last rows, the columns left of xa and right of xb) goes
+  // through a zero-padded copy of the G + 4 rows, computed into a scratch output and copied out.
+  const int scratch_cols = width + 4 + 2 * kMaxLanes;
+  std::vector<float> scratch_in(static_cast<std::size_t>(G + 4) * static_cast<std::size_t>(scratch_cols), 0.0F);
+  std::vector<float> scratch_out(static_cast<std::size_t>(G) * static_cast<std::size_t>(scratch_cols), 0.0F);
+  auto padded = [&](int y, int c0, int c1) {  // output columns [c0, c1) of rows y .. y + G - 1
+    const int cols = c1 - c0;
+    const int used = cols + 4 + kMaxLanes;  // what the pass reads of each scratch row
+    for (int i = 0; i < G + 4; ++i) {
+      float* dst = &scratch_in[static_cast<std::size_t>(i * scratch_cols)];
+      std::fill(dst, dst + used, 0.0F);
       const int r = y - 2 + i;
-      const bool valid = r >= 0 && r < height && row_valid[static_cast<std::size_t>(r)] != 0;
-      rows[i] = valid ? ring.row(r % kRing, 0) : empty;
-      any |= valid;
+      if (r < 0 || r >= height) continue;
+      const int s0 = std::max(c0 - 2, 0), s1 = std::min(c1 + 2, width);
+      std::memcpy(dst + 2 + (s0 - c0), sparse[r] + s0, sizeof(float) * static_cast<std::size_t>(s1 - s0));
     }
-    for (int j = 0; j < kDiamondGroup; ++j) out[j] = y + j < height ? dense[y + j] : nullptr;
+    DiamondBlock b = block;
+    b.in = scratch_in.data() + 2;
+    b.in_step = scratch_cols;
+    b.out = scratch_out.data();
+    b.out_step = scratch_cols;
+    b.x0 = 0;
+    b.x1 = cols;
+    diamond5(b);
+    for (int j = 0; j < G && y + j < height; ++j) {
+      std::memcpy(dense[y + j] + c0, &scratch_out[static_cast<std::size_t>(j * scratch_cols)],
+                  sizeof(float) * static_cast<std::size_t>(cols));
+    }
+  };
+
+  // Rows without any sample (the top third of a KITTI frame) are only scanned: a group whose input
+  // rows are all empty is zeroed. (A row with samples stops the scan at its first one.)
+  std::vector<std::uint8_t> row_any(static_cast<std::size_t>(height));
+  for (int r = 0; r < height; ++r) row_any[static_cast<std::size_t>(r)] = has_depth(sparse[r], width) ? 1 : 0;
+
+  for (int y = 0; y < height; y += G) {
+    bool any = false;
+    for (int r = std::max(y - 2, 0); r < std::min(y + G + 2, height); ++r) any |= row_any[static_cast<std::size_t>(r)] != 0;
     if (!any) {
-      for (float* row : out) {
-        if (row != nullptr) std::memset(row, 0, sizeof(float) * static_cast<std::size_t>(width));
-      }
+      for (int j = 0; j < G && y + j < height; ++j)
+        std::memset(dense[y + j], 0, sizeof(float) * static_cast<std::size_t>(width));
       continue;
     }
-    diamond5_rows(rows, out, width, inv.m, inv.threshold);
+    if (y < 2 || y + G + 2 > height || xb <= xa) {
+      padded(y, 0, width);
+      continue;
+    }
+    DiamondBlock b = block;
+    b.in = sparse[y - 2];
+    b.in_step = static_cast<std::ptrdiff_t>(sparse.step1());
+    b.out = dense[y];
+    b.out_step = static_cast<std::ptrdiff_t>(dense.step1());
+    b.x0 = xa;
+    b.x1 = xb;
+    diamond5(b);
+    padded(y, 0, xa);
+    padded(y, xb, width);
   }
 }
 

@@ -134,6 +134,23 @@ TEST_CASE("dilation equals the OpenCV reference bit for bit on random sparse ima
       CHECK(bit_identical(rgbl::dilate_depth(sparse, o), reference(sparse, o)));
     }
   }
+  // Sizes around the diamond's vector blocks (16 columns, 8 rows per pass, 2 of border) and views into
+  // a larger image, whose rows are not contiguous and whose neighbours must not leak in.
+  const cv::Mat_<float> big = [&] {
+    cv::Mat_<float> m(80, 160, 0.0F);
+    for (auto& d : m) d = coin(rng) < 0.1F ? depth(rng) : 0.0F;
+    return m;
+  }();
+  for (const auto& [rows, cols] : {std::pair{1, 1}, {2, 3}, {5, 17}, {9, 19}, {12, 20}, {13, 34}, {17, 35}, {24, 50}, {80, 160}}) {
+    for (const bool view : {false, true}) {
+      const int x0 = view ? (160 - cols) / 2 : 0, y0 = view ? (80 - rows) / 2 : 0;
+      const cv::Mat_<float> sparse = view ? big(cv::Rect(x0, y0, cols, rows)) : cv::Mat_<float>(big(cv::Rect(0, 0, cols, rows)).clone());
+      for (const auto& o : all_kernels()) {
+        INFO(o.kernel().name() << " " << rows << " x " << cols << (view ? " view" : ""));
+        CHECK(bit_identical(rgbl::dilate_depth(sparse, o), reference(sparse, o)));
+      }
+    }
+  }
 }
 
 TEST_CASE("dilation equals the reference and keypoint lookup equals the dense map on real frames") {
