@@ -103,6 +103,7 @@ void OrbSettings::validate() const {
   require(n_levels >= 1 && n_levels <= 32, "ORBextractor.nLevels", "1..32 pyramid levels");
   require(ini_th_fast > 0 && ini_th_fast < 256, "ORBextractor.iniThFAST", "a FAST threshold in 1..255");
   require(min_th_fast > 0 && min_th_fast <= ini_th_fast, "ORBextractor.minThFAST", "a FAST threshold in 1..iniThFAST");
+  require(!features_per_node || *features_per_node >= 1, "ORBextractor.featuresPerNode", "a count >= 1");
 }
 
 Settings read_settings(const std::filesystem::path& yaml) {
@@ -209,6 +210,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
   if (const auto v = r.integer({"ORBextractor.nLevels"})) s.orb.n_levels = *v;
   if (const auto v = r.integer({"ORBextractor.iniThFAST"})) s.orb.ini_th_fast = *v;
   if (const auto v = r.integer({"ORBextractor.minThFAST"})) s.orb.min_th_fast = *v;
+  if (const auto v = r.integer({"ORBextractor.featuresPerNode"})) s.orb.features_per_node = *v;
 
   if (const auto v = r.string({"LiDAR.Method"})) s.lidar_method = *v;
   if (const auto v = r.number({"LiDAR.min_dist"})) s.projection.min_depth = static_cast<float>(*v);

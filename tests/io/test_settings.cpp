@@ -91,6 +91,7 @@ TEST_CASE("settings: ORB-SLAM and RGB-L keys map onto rgbl values", "[io][settin
   CHECK(s.orb.n_levels == 8);
   CHECK(s.orb.ini_th_fast == 20);
   CHECK(s.orb.min_th_fast == 7);
+  CHECK_FALSE(s.orb.features_per_node);
   CHECK(s.lidar_method == "InverseDilation");
   CHECK(s.projection.min_depth == 5.0F);
   CHECK(s.projection.max_depth == 200.0F);
@@ -118,6 +119,7 @@ TEST_CASE("settings: a minimal file gives the defaults", "[io][settings]") {
   rgbl::test::TempDir tmp;
   const auto s = rgbl::read_settings(tmp.write("min.yaml", "%YAML:1.0\nORBextractor.nFeatures: 1500\n"));
   CHECK_FALSE(s.camera);
+  CHECK_FALSE(s.orb.features_per_node);
   CHECK_FALSE(s.T_cam_lidar);
   CHECK(s.orb.n_features == 1500);
   CHECK(s.orb.n_levels == 8);
@@ -145,6 +147,9 @@ TEST_CASE("settings: wrong types, incomplete groups and bad values name file and
   CHECK_THAT(
       error_of(tmp.write("h.yaml", replace(kRgblYaml, "ORBextractor.minThFAST: 7", "ORBextractor.minThFAST: 30"))),
       Contains("ORBextractor.minThFAST"));
+  CHECK_THAT(error_of(tmp.write("h2.yaml", replace(kRgblYaml, "ORBextractor.minThFAST: 7",
+                                                   "ORBextractor.minThFAST: 7\nORBextractor.featuresPerNode: 0"))),
+             Contains("'ORBextractor.featuresPerNode': expected a count >= 1"));
   CHECK_THAT(error_of(tmp.write("i.yaml", replace(kRgblYaml, "LiDAR.Tr11: -1.857739385241e-03", "LiDAR.Tr11: 2.0"))),
              Contains("rotation matrix"));
   CHECK_THAT(error_of(tmp.write("j.yaml", "%YAML:1.0\nCamera.fx: [1, 2\n")), Contains("j.yaml"));

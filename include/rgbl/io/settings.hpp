@@ -29,6 +29,8 @@ struct OrbSettings {
   int n_levels = 8;
   int ini_th_fast = 20;
   int min_th_fast = 7;
+  // rgbl's own key ORBextractor.featuresPerNode (OrbOptions::features_per_node); unset = the default.
+  std::optional<int> features_per_node;
 
   void validate() const;
 };
