@@ -1,4 +1,4 @@
-// rgbl_orb_quality [<kitti-sequence-dir> [<pairs> [<features_per_node>]]]
+// rgbl_orb_quality [<kitti-sequence-dir> [<pairs> [<features_per_node> [<spread_fraction>]]]]
 // Feature quality on consecutive frame pairs of a KITTI odometry sequence (default: seq 04 under
 // ../shared/data, 50 pairs of image_0): rgbl's ORB extractor against cv::ORB with the same feature
 // count, both matched by the same matchers:
@@ -180,6 +180,7 @@ int main(int argc, char** argv) {
     const int pairs = argc > 2 ? std::stoi(argv[2]) : 50;
     rgbl::OrbOptions orb_options;
     if (argc > 3) orb_options.features_per_node = std::stoi(argv[3]);
+    if (argc > 4) orb_options.spread_fraction = std::stod(argv[4]);
     // Ground truth beside the sequences folder, as in the KITTI odometry layout.
     const std::filesystem::path poses_file =
         seq.parent_path().parent_path() / "poses" / (seq.filename().string() + ".txt");
@@ -244,12 +245,12 @@ int main(int argc, char** argv) {
       prev_ours = std::move(cur_ours);
       prev_theirs = std::move(cur_theirs);
     }
-    fmt::print("{} consecutive pairs of {} (image_0), 2000 features, 8 levels, scale 1.2, rgbl features_per_node {}; "
+    fmt::print("{} consecutive pairs of {} (image_0), 2000 features, 8 levels, scale 1.2, rgbl features_per_node {}, spread_fraction {}; "
                "mean per pair.\n"
                "global: brute force, ratio 0.8, cross check. guided: keypoints with LiDAR depth predicted with the "
                "ground-truth motion, match_guided defaults. agree = Sampson distance to the ground-truth epipolar "
                "geometry < 1 px. occupied cells: share of a 32 x 10 grid holding a keypoint.\n\n",
-               pairs, seq.string(), orb_options.features_per_node);
+               pairs, seq.string(), orb_options.features_per_node, orb_options.spread_fraction);
     fmt::print("| extractor | features | occupied cells | ms/frame | global matches | global agree | F-RANSAC inliers | guided queries "
                "| guided matches | guided agree |\n");
     fmt::print("|---|---|---|---|---|---|---|---|---|---|\n");

@@ -64,6 +64,7 @@ void apply_settings(const Settings& s, Pipeline& p) {
   p.orb.fast_threshold = s.orb.ini_th_fast;
   p.orb.fast_min_threshold = s.orb.min_th_fast;
   if (s.orb.features_per_node) p.orb.features_per_node = *s.orb.features_per_node;
+  if (s.orb.spread_fraction) p.orb.spread_fraction = *s.orb.spread_fraction;
   p.depth_settings.lidar.projection = s.projection;
   p.depth_settings.lidar.dilation.max_depth = s.projection.max_depth;
   if (!s.lidar_method.empty() && s.lidar_method != "InverseDilation") {

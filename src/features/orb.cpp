@@ -26,6 +26,7 @@ void OrbOptions::validate() const {
           "in [1, fast_threshold]");
   require(cell_size >= 8, "orb.cell_size", ">= 8");
   require(features_per_node >= 1, "orb.features_per_node", ">= 1");
+  require(spread_fraction > 0.0 && spread_fraction <= 1.0, "orb.spread_fraction", "a fraction in (0, 1]");
   require(patch_size >= 5 && patch_size % 2 == 1, "orb.patch_size", "odd and >= 5");
   require(orientation_radius >= 1, "orb.orientation_radius", ">= 1");
   require(edge_threshold >= std::max(patch_size / 2, orientation_radius) + 1 && edge_threshold >= 4,
@@ -247,9 +248,12 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
     selected.assign(candidates_.begin(), candidates_.end());
     return;
   }
-  // The quadtree aims at target / per_node nodes, each contributing its per_node strongest corners.
+  // The quadtree places spread_fraction of the target, aiming at that / per_node nodes, each
+  // contributing its per_node strongest corners; the rest of the target goes to the strongest corners
+  // left over, wherever they are.
+  const int spread_target = std::max(1, static_cast<int>(std::lround(options_.spread_fraction * target)));
   const int per_node = options_.features_per_node;
-  const int target_nodes = (target + per_node - 1) / per_node;
+  const int target_nodes = (spread_target + per_node - 1) / per_node;
   float min_x = candidates_[0].x, max_x = min_x, min_y = candidates_[0].y, max_y = min_y;
   for (const auto& c : candidates_) {
     min_x = std::min(min_x, c.x);
@@ -350,11 +354,24 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
     std::partial_sort(first, first + keep, last, stronger);
     selected.insert(selected.end(), first, first + keep);
   }
-  if (static_cast<int>(selected.size()) > target) {
+  leftover_.clear();
+  if (static_cast<int>(selected.size()) > spread_target) {
     std::stable_sort(selected.begin(), selected.end(),
                      [](const Candidate& a, const Candidate& b) { return a.response > b.response; });
-    selected.resize(static_cast<std::size_t>(target));
+    leftover_.assign(selected.begin() + spread_target, selected.end());
+    selected.resize(static_cast<std::size_t>(spread_target));
   }
+  const int rest = target - static_cast<int>(selected.size());
+  if (rest <= 0) return;
+  // The rest from the corners the quadtree did not take: those the trimming above dropped and
+  // everything behind each node's kept ones.
+  for (const Node& node : nodes_) {
+    const int keep = std::min(per_node, node.end - node.begin);
+    leftover_.insert(leftover_.end(), candidates_.begin() + node.begin + keep, candidates_.begin() + node.end);
+  }
+  const auto take = std::min(static_cast<std::size_t>(rest), leftover_.size());
+  std::partial_sort(leftover_.begin(), leftover_.begin() + static_cast<std::ptrdiff_t>(take), leftover_.end(), stronger);
+  selected.insert(selected.end(), leftover_.begin(), leftover_.begin() + static_cast<std::ptrdiff_t>(take));
 }
 
 void OrbExtractor::describe_level(int level, std::span<const Candidate> selected, std::vector<Keypoint>& keypoints,

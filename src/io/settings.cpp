@@ -104,6 +104,8 @@ void OrbSettings::validate() const {
   require(ini_th_fast > 0 && ini_th_fast < 256, "ORBextractor.iniThFAST", "a FAST threshold in 1..255");
   require(min_th_fast > 0 && min_th_fast <= ini_th_fast, "ORBextractor.minThFAST", "a FAST threshold in 1..iniThFAST");
   require(!features_per_node || *features_per_node >= 1, "ORBextractor.featuresPerNode", "a count >= 1");
+  require(!spread_fraction || (*spread_fraction > 0.0 && *spread_fraction <= 1.0), "ORBextractor.spreadFraction",
+          "a fraction in (0, 1]");
 }
 
 Settings read_settings(const std::filesystem::path& yaml) {
@@ -211,6 +213,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
   if (const auto v = r.integer({"ORBextractor.iniThFAST"})) s.orb.ini_th_fast = *v;
   if (const auto v = r.integer({"ORBextractor.minThFAST"})) s.orb.min_th_fast = *v;
   if (const auto v = r.integer({"ORBextractor.featuresPerNode"})) s.orb.features_per_node = *v;
+  if (const auto v = r.number({"ORBextractor.spreadFraction"})) s.orb.spread_fraction = *v;
 
   if (const auto v = r.string({"LiDAR.Method"})) s.lidar_method = *v;
   if (const auto v = r.number({"LiDAR.min_dist"})) s.projection.min_depth = static_cast<float>(*v);

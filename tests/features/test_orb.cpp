@@ -13,6 +13,7 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <tuple>
 #include <type_traits>
 
 namespace {
@@ -275,6 +276,32 @@ TEST_CASE("ORB: keypoints spread, no empty cell of a 4x4 grid", "[features][orb]
   if (const auto img = kitti_frame()) check_spread(*img);
 }
 
+TEST_CASE("ORB: spread_fraction trades spread for corner strength at the same count", "[features][orb]") {
+  const auto img = kitti_frame();
+  if (!img) return;
+  auto stats = [&](double fraction) {
+    rgbl::OrbOptions o;
+    o.spread_fraction = fraction;
+    const Extracted e = extract(*img, o);
+    double response = 0.0;
+    std::set<int> cells;  // 32 x 10 grid
+    for (const auto& k : e.keypoints) {
+      response += k.response;
+      cells.insert(static_cast<int>(k.y * 10.0F / static_cast<float>(img->rows)) * 32 +
+                   static_cast<int>(k.x * 32.0F / static_cast<float>(img->cols)));
+    }
+    return std::tuple{e.keypoints.size(), response / static_cast<double>(e.keypoints.size()), cells.size()};
+  };
+  const auto [n_spread, response_spread, cells_spread] = stats(1.0);
+  const auto [n_half, response_half, cells_half] = stats(0.5);
+  INFO("mean FAST score " << response_spread << " -> " << response_half << ", occupied cells " << cells_spread << " -> "
+                          << cells_half);
+  CHECK(n_spread == 2000);
+  CHECK(n_half == 2000);
+  CHECK(response_half > 1.2 * response_spread);
+  CHECK(cells_half < cells_spread);
+}
+
 TEST_CASE("ORB: in-plane rotation invariance on a real frame", "[features][orb]") {
   const auto img = kitti_frame();
   if (!img) return;
@@ -356,6 +383,11 @@ TEST_CASE("ORB options validation names the key", "[features][orb]") {
   o = {};
   o.fast_min_threshold = 13;
   CHECK(key_of(o) == "orb.fast_min_threshold");
+  o = {};
+  o.spread_fraction = 0.0;
+  CHECK(key_of(o) == "orb.spread_fraction");
+  o.spread_fraction = 1.5;
+  CHECK(key_of(o) == "orb.spread_fraction");
   o = {};
   o.patch_size = 30;
   CHECK(key_of(o) == "orb.patch_size");

@@ -150,6 +150,9 @@ TEST_CASE("settings: wrong types, incomplete groups and bad values name file and
   CHECK_THAT(error_of(tmp.write("h2.yaml", replace(kRgblYaml, "ORBextractor.minThFAST: 7",
                                                    "ORBextractor.minThFAST: 7\nORBextractor.featuresPerNode: 0"))),
              Contains("'ORBextractor.featuresPerNode': expected a count >= 1"));
+  CHECK_THAT(error_of(tmp.write("h3.yaml", replace(kRgblYaml, "ORBextractor.minThFAST: 7",
+                                                   "ORBextractor.minThFAST: 7\nORBextractor.spreadFraction: 1.5"))),
+             Contains("'ORBextractor.spreadFraction': expected a fraction in (0, 1]"));
   CHECK_THAT(error_of(tmp.write("i.yaml", replace(kRgblYaml, "LiDAR.Tr11: -1.857739385241e-03", "LiDAR.Tr11: 2.0"))),
              Contains("rotation matrix"));
   CHECK_THAT(error_of(tmp.write("j.yaml", "%YAML:1.0\nCamera.fx: [1, 2\n")), Contains("j.yaml"));

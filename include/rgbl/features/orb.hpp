@@ -34,6 +34,9 @@ struct OrbOptions {
   // keeps the features_per_node strongest corners of each: 1 is ORB-SLAM's distribution; larger
   // values trade spread for strength (see docs/features.md).
   int features_per_node = 1;
+  // Share of each level's budget placed by the quadtree; the rest goes to the strongest remaining
+  // corners anywhere (1 = all spread, ORB-SLAM; see docs/features.md).
+  double spread_fraction = 1.0;
   int edge_threshold = 19;      // keypoints keep this many px from every level border
   int patch_size = 31;          // BRIEF patch diameter; sampling points lie within patch_size / 2
   int orientation_radius = 15;  // intensity-centroid disc radius
@@ -110,6 +113,7 @@ class OrbExtractor {
   std::vector<std::uint8_t> fast_scores_;
   std::vector<int> root_counts_;
   std::vector<Candidate> bucketed_;
+  std::vector<Candidate> leftover_;  // corners the quadtree did not take
   std::vector<Candidate> candidates_;
   std::vector<Candidate> selected_;
   std::vector<Node> nodes_, next_nodes_;

@@ -31,6 +31,8 @@ struct OrbSettings {
   int min_th_fast = 7;
   // rgbl's own key ORBextractor.featuresPerNode (OrbOptions::features_per_node); unset = the default.
   std::optional<int> features_per_node;
+  // rgbl's own key ORBextractor.spreadFraction (OrbOptions::spread_fraction); unset = the default.
+  std::optional<double> spread_fraction;
 
   void validate() const;
 };
