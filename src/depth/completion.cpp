@@ -1,5 +1,6 @@
 #include "rgbl/depth/completion.hpp"
 
+#include "rgbl/core/cpu_dispatch.hpp"
 #include "rgbl/core/error.hpp"
 
 #include <opencv2/core.hpp>
@@ -11,17 +12,6 @@
 #include <cstring>
 #include <limits>
 #include <type_traits>
-
-// Run-time selection of AVX2 (x86-64-v3) / AVX-512 (x86-64-v4) builds of the hot loops, with a plain
-// baseline for other CPUs. GCC on x86-64 only; elsewhere the portable code is compiled once. Not
-// under ThreadSanitizer: GCC instruments the ifunc resolvers, which the dynamic loader runs before
-// the TSan runtime is initialised, so every binary linking this file crashed at start-up.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_THREAD__)
-#define RGBL_CLONES_AVX2 __attribute__((target_clones("arch=x86-64-v3", "default")))
-#define RGBL_X86_DISPATCH 1
-#else
-#define RGBL_CLONES_AVX2
-#endif
 
 namespace rgbl {
 

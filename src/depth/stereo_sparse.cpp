@@ -11,15 +11,11 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "rgbl/core/cpu_dispatch.hpp"
 #include "rgbl/core/error.hpp"
 #include "rgbl/depth/sources.hpp"
 #include "source_checks.hpp"
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define RGBL_CLONES_AVX2 __attribute__((target_clones("arch=x86-64-v3", "default")))
-#else
-#define RGBL_CLONES_AVX2
-#endif
 
 namespace rgbl {
 
