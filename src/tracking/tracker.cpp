@@ -78,7 +78,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     outcome.initialised_now = true;
     outcome.inliers = count_tracked(frame);
     last_ok_frame_ = frame.index;
-    last_inliers_ = outcome.inliers;
+    last_inliers_ = 0;  // every depth point is a landmark here: no yardstick for the next frame
     outcome.state = state_;
     last_frame_ = frame;
     last_frame_->grid = FeatureGrid();
@@ -100,7 +100,6 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     const double steps = (frame.timestamp - last_frame_->timestamp) / velocity_dt_;
     if (std::isfinite(steps) && steps > 0.0) T_predicted = se3_exp(steps * se3_log(*velocity_)) * T_last;
   }
-  const Frame input = frame;  // unmatched, for a second hypothesis from relocalisation
   bool ok = false;
   bool motion_ok = false;
   int motion_inliers = 0;
@@ -151,7 +150,8 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
       const std::vector<KeyframeId> local_keyframes = local_keyframes_;
       const std::vector<LandmarkId> local_landmarks = local_landmarks_;
       const std::size_t last_relocalisation = last_relocalisation_frame_;
-      Frame candidate = input;
+      Frame candidate = frame;  // tracking changed only its pose and matches
+      clear_matches(candidate);
       const bool relocalised = relocalise(candidate) && track_local_map(candidate).ok;
       const int candidate_inliers = relocalised ? count_tracked(candidate) : 0;
       if (relocalised && candidate_inliers > inliers) {
@@ -165,10 +165,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
         local_keyframes_ = local_keyframes;
         local_landmarks_ = local_landmarks;
         last_relocalisation_frame_ = last_relocalisation;
-        if (!relocalised) {
-          ok = false;
-          outcome.verification_failed = true;
-        }
+        if (!relocalised) ok = false;
       }
       logger()->debug("frame {}: motion model suspect ({} inliers, last frame {}; local map {}/{}): {}",
                       frame.index, motion_inliers, last_inliers_, local.inliers, local.visible,
@@ -189,7 +186,6 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     state_ = TrackState::Lost;
     inliers = 0;
     last_inliers_ = 0;
-    frame = input;
     frame.T_cam_world = T_predicted;  // best guess, reported with state Lost
     clear_matches(frame);
     // Lost beyond the recent-loss window and the map does not know this place: carry on in a new map

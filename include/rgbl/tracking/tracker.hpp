@@ -22,7 +22,6 @@ struct TrackerOutcome {
   bool initialised_now = false;
   bool relocalised = false;
   bool new_map = false;         // lost, relocalisation failed: a new map was started at this frame
-  bool verification_failed = false;  // the motion-model hypothesis was suspect and not confirmed
   bool need_keyframe = false;
   int inliers = 0;
 };
