@@ -127,13 +127,16 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
       outcome.relocalised = ok;
     }
   }
+  const bool relocalisation_tried = state_ == TrackState::Lost && !motion_ok;
   int inliers = 0;
   bool weak = false;
+  bool is_suspect = false;
+  LocalMapResult local;
   if (ok) {
     const Frame after_motion = motion_ok ? frame : Frame{};
-    const LocalMapResult local = track_local_map(frame);
+    local = track_local_map(frame);
     ok = local.ok;
-    const bool is_suspect = motion_ok && suspect(motion_inliers, local);
+    is_suspect = motion_ok && suspect(motion_inliers, local);
     if (!ok && motion_ok && options_.keep_weak_tracking && !is_suspect) {
       // The map is thin here (e.g. mapping lags behind) but frame-to-frame motion held: keep the
       // motion-model pose and refresh the map with a keyframe instead of declaring the camera lost.
@@ -143,30 +146,32 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
       weak = true;
     }
     inliers = ok ? count_tracked(frame) : 0;
+  }
+  if ((is_suspect || !ok) && !relocalisation_tried) {
+    // A second hypothesis from the whole map, independent of any prediction, for a suspect pose and
+    // before declaring the camera lost. Its side effects on the local map are undone if not taken.
+    const KeyframeId reference = reference_;
+    const std::vector<KeyframeId> local_keyframes = local_keyframes_;
+    const std::vector<LandmarkId> local_landmarks = local_landmarks_;
+    const std::size_t last_relocalisation = last_relocalisation_frame_;
+    Frame candidate = frame;  // tracking changed only its pose and matches
+    clear_matches(candidate);
+    const bool relocalised = relocalise(candidate) && track_local_map(candidate).ok;
+    const int candidate_inliers = relocalised ? count_tracked(candidate) : 0;
+    if (relocalised && candidate_inliers > inliers) {
+      frame = std::move(candidate);
+      inliers = candidate_inliers;
+      ok = true;
+      weak = false;
+      outcome.relocalised = true;
+    } else {
+      reference_ = reference;
+      local_keyframes_ = local_keyframes;
+      local_landmarks_ = local_landmarks;
+      last_relocalisation_frame_ = last_relocalisation;
+      if (!relocalised && is_suspect) ok = false;
+    }
     if (is_suspect) {
-      // Second hypothesis from the whole map, independent of any prediction. Its side effects on the
-      // tracker's local map are undone when it is not taken.
-      const KeyframeId reference = reference_;
-      const std::vector<KeyframeId> local_keyframes = local_keyframes_;
-      const std::vector<LandmarkId> local_landmarks = local_landmarks_;
-      const std::size_t last_relocalisation = last_relocalisation_frame_;
-      Frame candidate = frame;  // tracking changed only its pose and matches
-      clear_matches(candidate);
-      const bool relocalised = relocalise(candidate) && track_local_map(candidate).ok;
-      const int candidate_inliers = relocalised ? count_tracked(candidate) : 0;
-      if (relocalised && candidate_inliers > inliers) {
-        frame = std::move(candidate);
-        inliers = candidate_inliers;
-        ok = true;
-        weak = false;
-        outcome.relocalised = true;
-      } else {
-        reference_ = reference;
-        local_keyframes_ = local_keyframes;
-        local_landmarks_ = local_landmarks;
-        last_relocalisation_frame_ = last_relocalisation;
-        if (!relocalised) ok = false;
-      }
       logger()->debug("frame {}: motion model suspect ({} inliers, last frame {}; local map {}/{}): {}",
                       frame.index, motion_inliers, last_inliers_, local.inliers, local.visible,
                       outcome.relocalised ? "relocalised" : (ok ? "confirmed" : "lost"));
