@@ -1,8 +1,9 @@
 #pragma once
 // The tracking state machine: not initialised -> ok <-> lost. Each frame is matched against the map
-// (motion model, reference-keyframe fallback, local map, relocalisation) and its pose optimised; the
-// tracker also decides when a frame becomes a keyframe. It never throws on bad input: failure is a
-// state.
+// (motion model, reference-keyframe fallback, local map, relocalisation) and its pose optimised; a
+// suspect motion-model pose is checked by relocalisation, and a camera lost where the map cannot place
+// it starts a new map. The tracker also decides when a frame becomes a keyframe. It never throws on bad
+// input: failure is a state.
 
 #include "rgbl/geometry/camera.hpp"
 #include "rgbl/map/map.hpp"
