@@ -267,6 +267,12 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
     if (r.result.state != TrackState::Lost) continue;
     lost_frames += (lost_frames.empty() ? "" : ", ") + std::to_string(r.result.frame_index);
   }
+  // Frames where tracking, lost beyond relocalisation, started a new map anchored at a guessed pose.
+  std::string new_map_frames;
+  for (const auto& r : records) {
+    if (!r.result.new_map) continue;
+    new_map_frames += (new_map_frames.empty() ? "" : ", ") + std::to_string(r.result.frame_index);
+  }
   {
     const auto file = out_dir / "summary.json";
     std::ofstream json(file);
@@ -275,8 +281,10 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
                         json_string(p.sequence->path().string()), json_string(std::string(to_string(p.sequence->format()))),
                         p.camera, json_string(p.depth_name))
          << fmt::format("  \"frames\": {},\n  \"tracked\": {},\n  \"lost\": {},\n  \"not_initialised\": {},\n"
-                        "  \"lost_frames\": [{}],\n  \"keyframes\": {},\n  \"landmarks\": {},\n",
-                        out.frames, out.tracked, out.lost, out.not_initialised, lost_frames, out.keyframes, out.landmarks)
+                        "  \"lost_frames\": [{}],\n  \"new_map_frames\": [{}],\n  \"keyframes\": {},\n"
+                        "  \"landmarks\": {},\n",
+                        out.frames, out.tracked, out.lost, out.not_initialised, lost_frames, new_map_frames,
+                        out.keyframes, out.landmarks)
          << fmt::format("  \"threaded_mapping\": {},\n  \"wall_s\": {},\n", threaded ? "true" : "false",
                         json_number(out.wall_s))
          << "  \"stage_ms\": {\n    " << stage_json("io_wait", stats(io_ms)) << ",\n    "
@@ -292,6 +300,7 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
              to_string(p.sequence->format()), p.camera, p.depth_name, out.frames, out.wall_s);
   fmt::print("  tracked {}, lost {}, not initialised {}; {} keyframes, {} landmarks\n", out.tracked, out.lost,
              out.not_initialised, out.keyframes, out.landmarks);
+  if (!new_map_frames.empty()) fmt::print("  lost beyond relocalisation: new map started at frame(s) {}\n", new_map_frames);
   fmt::print("  per frame (median / p95 ms): depth {:.2f} / {:.2f}, extraction {:.2f} / {:.2f}, tracking {:.2f} / "
              "{:.2f}, mapping {:.2f} / {:.2f}\n",
              depth.median, depth.p95, extraction.median, extraction.p95, tracking.median, tracking.p95,

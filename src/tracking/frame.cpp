@@ -18,6 +18,10 @@ void TrackerOptions::validate() const {
   require(reference_ratio > 0.0 && reference_ratio <= 1.0, "tracker.reference_ratio", "in (0, 1]");
   require(max_local_keyframes >= 1, "tracker.max_local_keyframes", ">= 1");
   require(min_pose_inliers >= 3, "tracker.min_pose_inliers", ">= 3");
+  require(verify_min_found_ratio >= 0.0 && verify_min_found_ratio <= 1.0, "tracker.verify_min_found_ratio",
+          "in [0, 1]");
+  require(verify_min_motion_ratio >= 0.0 && verify_min_motion_ratio <= 1.0, "tracker.verify_min_motion_ratio",
+          "in [0, 1]");
   require(relocalisation_min_matches >= 6, "tracker.relocalisation_min_matches", ">= 6 (PnP RANSAC)");
   require(max_frames_between_keyframes >= 1, "tracker.max_frames_between_keyframes", ">= 1");
   require(close_depth > 0.0, "tracker.close_depth", "> 0");

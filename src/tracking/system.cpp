@@ -193,6 +193,8 @@ TrackResult System::track(const SensorFrame& sensor) {
 
   result.state = outcome.state;
   result.keyframe = outcome.initialised_now || new_keyframe.valid();
+  result.relocalised = outcome.relocalised;
+  result.new_map = outcome.new_map;
   result.inliers = outcome.inliers;
   result.keypoints = static_cast<int>(n);
   result.keypoints_with_depth = with_depth;

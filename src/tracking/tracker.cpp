@@ -2,6 +2,8 @@
 
 #include "matching.hpp"
 #include "rgbl/backend/pose_optimizer.hpp"
+#include "rgbl/core/log.hpp"
+#include "rgbl/geometry/se3.hpp"
 
 #include <opencv2/calib3d.hpp>
 
@@ -68,13 +70,22 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   TrackerOutcome outcome;
   frame.landmarks.assign(frame.size(), LandmarkId{});
   frame.outlier.assign(frame.size(), false);
+  auto count_tracked = [](const Frame& f) {
+    return static_cast<int>(std::count_if(f.landmarks.begin(), f.landmarks.end(), [](LandmarkId l) { return l.valid(); }));
+  };
+  auto finish_initialised = [&] {
+    state_ = TrackState::Ok;
+    outcome.initialised_now = true;
+    outcome.inliers = count_tracked(frame);
+    last_ok_frame_ = frame.index;
+    last_inliers_ = 0;  // every depth point is a landmark here: no yardstick for the next frame
+    outcome.state = state_;
+    last_frame_ = frame;
+    last_frame_->grid = FeatureGrid();
+    return outcome;
+  };
   if (state_ == TrackState::NotInitialised) {
-    if (initialise(frame)) {
-      state_ = TrackState::Ok;
-      outcome.initialised_now = true;
-      outcome.inliers = static_cast<int>(std::count_if(frame.landmarks.begin(), frame.landmarks.end(),
-                                                       [](LandmarkId l) { return l.valid(); }));
-    }
+    if (initialise(frame, Eigen::Isometry3d::Identity())) return finish_initialised();
     outcome.state = state_;
     last_frame_ = frame;
     last_frame_->grid = FeatureGrid();
@@ -82,11 +93,22 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   }
 
   const Eigen::Isometry3d T_last = last_frame_ ? last_frame_->T_cam_world : Eigen::Isometry3d::Identity();
-  const Eigen::Isometry3d T_predicted = velocity_ ? *velocity_ * T_last : T_last;
+  // Best guess for a lost frame: constant velocity over the time elapsed since the last frame, so
+  // that dropped frames (a gap in the timestamps) move the guess as far as the camera went.
+  Eigen::Isometry3d T_predicted = velocity_ ? *velocity_ * T_last : T_last;
+  if (velocity_ && last_frame_ && velocity_dt_ > 0.0) {
+    const double steps = (frame.timestamp - last_frame_->timestamp) / velocity_dt_;
+    if (std::isfinite(steps) && steps > 0.0) T_predicted = se3_exp(steps * se3_log(*velocity_)) * T_last;
+  }
   bool ok = false;
   bool motion_ok = false;
+  int motion_inliers = 0;
+  bool recent_loss = false;
   if (state_ == TrackState::Ok) {
-    if (velocity_ && last_frame_) ok = motion_ok = track_with_motion_model(frame);
+    if (velocity_ && last_frame_) {
+      motion_inliers = track_with_motion_model(frame);
+      ok = motion_ok = motion_inliers >= options_.min_pose_inliers;
+    }
     if (!ok) {
       clear_matches(frame);
       ok = track_reference_keyframe(frame);
@@ -94,8 +116,10 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   } else {
     // Recently lost: the frame-to-frame motion (depth RANSAC + temporary points) usually still holds
     // and keeps the trajectory continuous; otherwise relocalise against the whole map.
-    if (velocity_ && last_frame_ && frame.index <= last_ok_frame_ + options_.recent_loss_frames) {
-      ok = motion_ok = track_with_motion_model(frame);
+    recent_loss = velocity_ && last_frame_ && frame.index <= last_ok_frame_ + options_.recent_loss_frames;
+    if (recent_loss) {
+      motion_inliers = track_with_motion_model(frame);
+      ok = motion_ok = motion_inliers >= options_.min_pose_inliers;
       if (!ok) clear_matches(frame);
     }
     if (!ok) {
@@ -103,12 +127,17 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
       outcome.relocalised = ok;
     }
   }
+  const bool relocalisation_tried = state_ == TrackState::Lost && !motion_ok;
   int inliers = 0;
   bool weak = false;
+  bool is_suspect = false;
+  LocalMapResult local;
   if (ok) {
     const Frame after_motion = motion_ok ? frame : Frame{};
-    ok = track_local_map(frame);
-    if (!ok && motion_ok && options_.keep_weak_tracking) {
+    local = track_local_map(frame);
+    ok = local.ok;
+    is_suspect = motion_ok && suspect(motion_inliers, local);
+    if (!ok && motion_ok && options_.keep_weak_tracking && !is_suspect) {
       // The map is thin here (e.g. mapping lags behind) but frame-to-frame motion held: keep the
       // motion-model pose and refresh the map with a keyframe instead of declaring the camera lost.
       frame = after_motion;
@@ -116,18 +145,62 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
       ok = true;
       weak = true;
     }
-    inliers = static_cast<int>(std::count_if(frame.landmarks.begin(), frame.landmarks.end(),
-                                             [](LandmarkId l) { return l.valid(); }));
+    inliers = ok ? count_tracked(frame) : 0;
+  }
+  if ((is_suspect || !ok) && !relocalisation_tried) {
+    // A second hypothesis from the whole map, independent of any prediction, for a suspect pose and
+    // before declaring the camera lost. Its side effects on the local map are undone if not taken.
+    const KeyframeId reference = reference_;
+    const std::vector<KeyframeId> local_keyframes = local_keyframes_;
+    const std::vector<LandmarkId> local_landmarks = local_landmarks_;
+    const std::size_t last_relocalisation = last_relocalisation_frame_;
+    Frame candidate = frame;  // tracking changed only its pose and matches
+    clear_matches(candidate);
+    const bool relocalised = relocalise(candidate) && track_local_map(candidate).ok;
+    const int candidate_inliers = relocalised ? count_tracked(candidate) : 0;
+    if (relocalised && candidate_inliers > inliers) {
+      frame = std::move(candidate);
+      inliers = candidate_inliers;
+      ok = true;
+      weak = false;
+      outcome.relocalised = true;
+    } else {
+      reference_ = reference;
+      local_keyframes_ = local_keyframes;
+      local_landmarks_ = local_landmarks;
+      last_relocalisation_frame_ = last_relocalisation;
+      if (!relocalised && is_suspect) ok = false;
+    }
+    if (is_suspect) {
+      logger()->debug("frame {}: motion model suspect ({} inliers, last frame {}; local map {}/{}): {}",
+                      frame.index, motion_inliers, last_inliers_, local.inliers, local.visible,
+                      outcome.relocalised ? "relocalised" : (ok ? "confirmed" : "lost"));
+    }
   }
   if (ok) {
     state_ = TrackState::Ok;
     last_ok_frame_ = frame.index;
-    if (last_frame_) velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
+    last_inliers_ = inliers;
+    if (last_frame_) {
+      velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
+      velocity_dt_ = frame.timestamp - last_frame_->timestamp;
+    }
     outcome.need_keyframe = weak || need_keyframe(frame, inliers, mapping_idle);
   } else {
+    const bool was_lost = state_ == TrackState::Lost;
     state_ = TrackState::Lost;
+    inliers = 0;
+    last_inliers_ = 0;
     frame.T_cam_world = T_predicted;  // best guess, reported with state Lost
     clear_matches(frame);
+    // Lost beyond the recent-loss window and the map does not know this place: carry on in a new map
+    // anchored at the guess (as ORB-SLAM3's atlas) rather than staying lost until the camera returns.
+    if (was_lost && !recent_loss && options_.new_map_when_lost && initialise(frame, T_predicted)) {
+      logger()->warn("frame {}: lost since frame {} and relocalisation failed: new map started at the "
+                     "constant-velocity guess", frame.index, last_ok_frame_);
+      outcome.new_map = true;
+      return finish_initialised();
+    }
   }
   outcome.state = state_;
   outcome.inliers = inliers;
@@ -136,11 +209,19 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   return outcome;
 }
 
-bool Tracker::initialise(Frame& frame) {
+bool Tracker::suspect(int motion_inliers, const LocalMapResult& local) const {
+  const bool map_disagrees = local.visible > 0 && static_cast<double>(local.inliers) <
+                                                      options_.verify_min_found_ratio * local.visible;
+  const bool motion_collapsed = last_inliers_ > 0 && static_cast<double>(motion_inliers) <
+                                                         options_.verify_min_motion_ratio * last_inliers_;
+  return map_disagrees || motion_collapsed;
+}
+
+bool Tracker::initialise(Frame& frame, const Eigen::Isometry3d& T_cam_world) {
   const int usable = static_cast<int>(std::count_if(frame.depth_sigma.begin(), frame.depth_sigma.end(),
                                                     [](float s) { return s > 0.0F; }));
   if (usable < options_.min_initial_depth_points) return false;
-  frame.T_cam_world = Eigen::Isometry3d::Identity();
+  frame.T_cam_world = T_cam_world;
   std::unique_lock lock(map_.mutex());
   const KeyframeId id = map_.add_keyframe(keyframe_from(frame));
   const Eigen::Isometry3d T_world_cam = frame.T_cam_world.inverse();
@@ -270,7 +351,7 @@ std::optional<Eigen::Isometry3d> depth_motion_ransac(const PinholeCamera& camera
 
 }  // namespace
 
-bool Tracker::track_with_motion_model(Frame& frame) {
+int Tracker::track_with_motion_model(Frame& frame) {
   frame.T_cam_world = *velocity_ * last_frame_->T_cam_world;
   if (options_.ransac_prediction) {
     if (const auto T_cur_last = depth_motion_ransac(camera_, *last_frame_, frame, options_)) {
@@ -327,7 +408,7 @@ bool Tracker::track_with_motion_model(Frame& frame) {
     matches = detail::match_projected(frame, candidates, options_.motion_max_hamming, options_.motion_ratio, options_.check_orientation,
                                       &candidate_of_keypoint, gate);
   }
-  if (matches < options_.motion_min_matches) return false;
+  if (matches < options_.motion_min_matches) return 0;
   std::vector<std::pair<std::size_t, Eigen::Vector3d>> extra;
   for (std::size_t k = 0; k < frame.size(); ++k) {
     const int c = candidate_of_keypoint[k];
@@ -337,7 +418,7 @@ bool Tracker::track_with_motion_model(Frame& frame) {
   }
   const int inliers = optimise_pose(frame, extra);
   discard_outliers(frame);
-  return inliers >= options_.min_pose_inliers;
+  return inliers;
 }
 
 bool Tracker::track_reference_keyframe(Frame& frame) {
@@ -385,6 +466,9 @@ void Tracker::update_local_map(const Frame& frame) {
     if (static_cast<int>(local_keyframes_.size()) >= options_.max_local_keyframes) break;
     push(kf);
   }
+  // Nothing matched yet (the frame was tracked on temporary points only, e.g. after a loss): search
+  // around the reference keyframe rather than in an empty local map.
+  if (local_keyframes_.empty() && map_.keyframe(reference_) != nullptr) push(reference_);
   const std::size_t direct = local_keyframes_.size();
   for (std::size_t i = 0; i < direct && static_cast<int>(local_keyframes_.size()) < options_.max_local_keyframes; ++i) {
     for (const KeyframeId n : map_.best_covisible(local_keyframes_[i], 10)) {
@@ -396,7 +480,7 @@ void Tracker::update_local_map(const Frame& frame) {
   local_landmarks_ = map_.landmarks_seen_by(local_keyframes_);
 }
 
-bool Tracker::track_local_map(Frame& frame) {
+Tracker::LocalMapResult Tracker::track_local_map(Frame& frame) {
   std::vector<detail::ProjectedLandmark> candidates;
   std::vector<LandmarkId> visible;
   {
@@ -456,7 +540,11 @@ bool Tracker::track_local_map(Frame& frame) {
   const bool recently_relocalised =
       last_relocalisation_frame_ > 0 && frame.index < last_relocalisation_frame_ + 
       static_cast<std::size_t>(options_.max_frames_between_keyframes);
-  return inliers >= (recently_relocalised ? options_.relocalisation_min_inliers : options_.min_local_map_inliers);
+  LocalMapResult result;
+  result.inliers = inliers;
+  result.visible = static_cast<int>(visible.size());
+  result.ok = inliers >= (recently_relocalised ? options_.relocalisation_min_inliers : options_.min_local_map_inliers);
+  return result;
 }
 
 bool Tracker::relocalise(Frame& frame) {

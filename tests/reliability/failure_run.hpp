@@ -15,15 +15,17 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace rgbl::test {
 
 struct Step {
-  std::size_t frame = 0;  // KITTI frame read from disk (also the SensorFrame index)
+  std::size_t frame = 0;  // KITTI frame read from disk (and its ground truth)
   bool black = false;     // replace the image by zeros
   bool drop_scan = false;
+  std::optional<std::size_t> index;  // SensorFrame index (timestamp 0.1 s x index) if not `frame`
 };
 
 struct Outcome {
@@ -51,8 +53,8 @@ inline Outcome run(const std::filesystem::path& sequence, const std::vector<Step
   std::vector<rgbl::LidarPoint> scan;
   for (const Step& step : steps) {
     rgbl::SensorFrame frame;
-    frame.index = step.frame;
-    frame.timestamp = 0.1 * static_cast<double>(step.frame);
+    frame.index = step.index.value_or(step.frame);
+    frame.timestamp = 0.1 * static_cast<double>(frame.index);
     frame.image = cv::imread((sequence / "image_0" / (name(step.frame) + ".png")).string(), cv::IMREAD_GRAYSCALE);
     REQUIRE(!frame.image.empty());
     if (step.black) frame.image = cv::Mat::zeros(frame.image.size(), CV_8UC1);
@@ -69,7 +71,11 @@ inline Outcome run(const std::filesystem::path& sequence, const std::vector<Step
 
 inline std::vector<Step> frames(std::size_t first, std::size_t last) {
   std::vector<Step> steps;
-  for (std::size_t i = first; i <= last; ++i) steps.push_back({i});
+  for (std::size_t i = first; i <= last; ++i) {
+    Step step;
+    step.frame = i;
+    steps.push_back(step);
+  }
   return steps;
 }
 

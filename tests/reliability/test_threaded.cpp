@@ -32,3 +32,19 @@ TEST_CASE("threaded mapping: black frames and a dropped scan, every frame record
   CHECK(o.results[13].state == rgbl::TrackState::Lost);
   CHECK(o.results.back().state == rgbl::TrackState::Ok);
 }
+
+TEST_CASE("threaded mapping: a jump of 20 frames starts a new map while mapping runs") {
+  const auto sequence = rgbl::test::kitti_seq04();
+  if (!sequence) return;
+  auto steps = rgbl::test::frames(0, 14);
+  const auto after = rgbl::test::frames(35, 44);
+  steps.insert(steps.end(), after.begin(), after.end());
+  const auto o = rgbl::test::run(*sequence, steps, true);
+  INFO(rgbl::test::states(o));
+  rgbl::test::check_complete(o);
+  CHECK(o.results[15].state == rgbl::TrackState::Lost);
+  int new_maps = 0;
+  for (const auto& r : o.results) new_maps += r.new_map ? 1 : 0;
+  CHECK(new_maps == 1);
+  CHECK(o.results.back().state == rgbl::TrackState::Ok);
+}

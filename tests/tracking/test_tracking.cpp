@@ -70,6 +70,12 @@ TEST_CASE("system: configuration errors name the key; no depth keeps it uninitia
   rgbl::SystemOptions bad;
   bad.tracker.max_hamming = 0;
   CHECK_THROWS_AS(rgbl::System(bad, small_camera(), std::make_unique<NoDepth>(), extractor), rgbl::ConfigError);
+  rgbl::TrackerOptions verify;
+  verify.verify_min_found_ratio = 1.5;
+  CHECK_THROWS_WITH(verify.validate(), Catch::Contains("tracker.verify_min_found_ratio"));
+  verify = {};
+  verify.verify_min_motion_ratio = -0.1;
+  CHECK_THROWS_WITH(verify.validate(), Catch::Contains("tracker.verify_min_motion_ratio"));
 
   rgbl::OrbExtractor orb;
   rgbl::System system({}, small_camera(), std::make_unique<NoDepth>(),

@@ -28,6 +28,17 @@ struct TrackerOptions {
   int relocalisation_min_inliers = 50;  // local-map inliers to accept it
   bool keep_weak_tracking = true;       // local map fails but the motion model held: keep going, add a keyframe
   std::size_t recent_loss_frames = 5;   // after a loss, try the motion model this long before relocalising
+  // Verification of the motion-model hypothesis (a jump in the input lands on a repetitive road that
+  // the map "explains" from a pose tens of metres off). It is suspect when the local-map search re-finds
+  // fewer than verify_min_found_ratio of the local-map points predicted visible, or the motion model
+  // keeps fewer than verify_min_motion_ratio of the last frame's inliers (0 = that check off). A suspect
+  // frame is relocalised against the whole map and the hypothesis with more local-map inliers is kept;
+  // if relocalisation fails, the frame is lost.
+  double verify_min_found_ratio = 0.05;
+  double verify_min_motion_ratio = 0.2;
+  // Lost for longer than recent_loss_frames and relocalisation failed: start a new map (disconnected
+  // keyframes in the same Map, anchored at the constant-velocity guess) instead of staying lost.
+  bool new_map_when_lost = true;
   bool check_orientation = true;        // rotation histogram consistency in guided matching
   // Depth gate in guided matching (0 sigmas = off): |measured - predicted z| <= max(min, sigmas * sigma).
   double depth_gate_sigmas = 3.0;

@@ -53,6 +53,8 @@ struct TrackResult {
   TrackState state = TrackState::NotInitialised;
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();  // world = first tracked camera pose
   bool keyframe = false;
+  bool relocalised = false;  // placed by relocalisation against the whole map
+  bool new_map = false;      // tracking was lost and a new map started here (poses anchored at a guess)
   int inliers = 0;
   int keypoints = 0, keypoints_with_depth = 0;
   StageTiming timing;

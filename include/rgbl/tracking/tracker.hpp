@@ -1,8 +1,9 @@
 #pragma once
 // The tracking state machine: not initialised -> ok <-> lost. Each frame is matched against the map
-// (motion model, reference-keyframe fallback, local map, relocalisation) and its pose optimised; the
-// tracker also decides when a frame becomes a keyframe. It never throws on bad input: failure is a
-// state.
+// (motion model, reference-keyframe fallback, local map, relocalisation) and its pose optimised; a
+// suspect motion-model pose is checked by relocalisation, and a camera lost where the map cannot place
+// it starts a new map. The tracker also decides when a frame becomes a keyframe. It never throws on bad
+// input: failure is a state.
 
 #include "rgbl/geometry/camera.hpp"
 #include "rgbl/map/map.hpp"
@@ -21,6 +22,7 @@ struct TrackerOutcome {
   TrackState state = TrackState::NotInitialised;
   bool initialised_now = false;
   bool relocalised = false;
+  bool new_map = false;         // lost, relocalisation failed: a new map was started at this frame
   bool need_keyframe = false;
   int inliers = 0;
 };
@@ -42,10 +44,19 @@ class Tracker {
   const std::optional<Eigen::Isometry3d>& velocity() const { return velocity_; }
 
  private:
-  bool initialise(Frame& frame);
-  bool track_with_motion_model(Frame& frame);
+  struct LocalMapResult {
+    bool ok = false;
+    int inliers = 0;
+    int visible = 0;  // local-map points predicted in view (searched for)
+  };
+
+  bool initialise(Frame& frame, const Eigen::Isometry3d& T_cam_world);
+  // Returns the pose inliers (landmarks and temporary points), 0 when matching failed.
+  int track_with_motion_model(Frame& frame);
   bool track_reference_keyframe(Frame& frame);
-  bool track_local_map(Frame& frame);
+  LocalMapResult track_local_map(Frame& frame);
+  // The motion-model hypothesis disagrees with the map or with the recent frames (see TrackerOptions).
+  bool suspect(int motion_inliers, const LocalMapResult& local) const;
   bool relocalise(Frame& frame);
   // extra: (keypoint, world point) correspondences that are not landmarks (temporary points).
   int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {});
@@ -60,8 +71,10 @@ class Tracker {
   std::size_t last_keyframe_frame_ = 0;
   std::size_t last_relocalisation_frame_ = 0;
   std::size_t last_ok_frame_ = 0;
+  int last_inliers_ = 0;  // of the last frame if it was tracked, else 0
   std::optional<Frame> last_frame_;
   std::optional<Eigen::Isometry3d> velocity_;  // T_cur_last
+  double velocity_dt_ = 0.0;  // timestamp difference of that pair (0 = unknown)
   std::vector<KeyframeId> local_keyframes_;
   std::vector<LandmarkId> local_landmarks_;
 };
