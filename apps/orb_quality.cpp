@@ -1,4 +1,4 @@
-// rgbl_orb_quality [<kitti-sequence-dir> [<pairs> [<features_per_node> [<spread_fraction>]]]]
+// rgbl_orb_quality [<kitti-sequence-dir> [<pairs> [<features_per_node> [<spread_fraction> [<fast_threshold> <fast_min_threshold>]]]]]
 // Feature quality on consecutive frame pairs of a KITTI odometry sequence (default: seq 04 under
 // ../shared/data, 50 pairs of image_0): rgbl's ORB extractor against cv::ORB with the same feature
 // count, both matched by the same matchers:
@@ -181,6 +181,8 @@ int main(int argc, char** argv) {
     rgbl::OrbOptions orb_options;
     if (argc > 3) orb_options.features_per_node = std::stoi(argv[3]);
     if (argc > 4) orb_options.spread_fraction = std::stod(argv[4]);
+    if (argc > 5) orb_options.fast_threshold = std::stoi(argv[5]);
+    if (argc > 6) orb_options.fast_min_threshold = std::stoi(argv[6]);
     // Ground truth beside the sequences folder, as in the KITTI odometry layout.
     const std::filesystem::path poses_file =
         seq.parent_path().parent_path() / "poses" / (seq.filename().string() + ".txt");
