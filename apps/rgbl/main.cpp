@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", RGBL_VERSION_STRING);
   bool quiet = false;
   app.add_flag("-q,--quiet", quiet, "Only print warnings and errors from the library");
+  bool verbose = false;
+  app.add_flag("-v,--verbose", verbose, "Also print the library's debug messages (e.g. why a frame was judged lost)");
 
   const std::vector<rgbl::cli::Command> commands{
       rgbl::cli::add_run_command(app),
@@ -38,7 +40,7 @@ int main(int argc, char** argv) {
   auto sink = std::make_shared<spdlog::sinks::stderr_color_sink_mt>();
   auto logger = std::make_shared<spdlog::logger>(rgbl::kLoggerName, sink);
   logger->set_pattern("%^%l%$: %v");
-  logger->set_level(quiet ? spdlog::level::warn : spdlog::level::info);
+  logger->set_level(quiet ? spdlog::level::warn : verbose ? spdlog::level::debug : spdlog::level::info);
   rgbl::set_logger(logger);
 
   try {

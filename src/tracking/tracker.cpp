@@ -210,10 +210,14 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
 }
 
 bool Tracker::suspect(int motion_inliers, const LocalMapResult& local) const {
-  const bool map_disagrees = local.visible > 0 && static_cast<double>(local.inliers) <
-                                                      options_.verify_min_found_ratio * local.visible;
-  const bool motion_collapsed = last_inliers_ > 0 && static_cast<double>(motion_inliers) <
-                                                         options_.verify_min_motion_ratio * last_inliers_;
+  // A check judges only where passing it means at least min_pose_inliers points: a local map or a
+  // last frame thinner than that is mapping lagging behind (threaded mode) or the weak-tracking
+  // fallback, and says nothing about the pose.
+  const double floor = options_.min_pose_inliers;
+  const double found_needed = options_.verify_min_found_ratio * local.visible;
+  const double motion_needed = options_.verify_min_motion_ratio * last_inliers_;
+  const bool map_disagrees = found_needed >= floor && local.inliers < found_needed;
+  const bool motion_collapsed = motion_needed >= floor && motion_inliers < motion_needed;
   return map_disagrees || motion_collapsed;
 }
 

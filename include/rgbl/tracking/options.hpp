@@ -31,7 +31,9 @@ struct TrackerOptions {
   // Verification of the motion-model hypothesis (a jump in the input lands on a repetitive road that
   // the map "explains" from a pose tens of metres off). It is suspect when the local-map search re-finds
   // fewer than verify_min_found_ratio of the local-map points predicted visible, or the motion model
-  // keeps fewer than verify_min_motion_ratio of the last frame's inliers (0 = that check off). A suspect
+  // keeps fewer than verify_min_motion_ratio of the last frame's inliers (0 = that check off). Each
+  // judges only where passing means at least min_pose_inliers points (a thinner local map or last
+  // frame is mapping lagging behind, as in threaded mode, and says nothing about the pose). A suspect
   // frame is relocalised against the whole map and the hypothesis with more local-map inliers is kept;
   // if relocalisation fails, the frame is lost.
   double verify_min_found_ratio = 0.05;
