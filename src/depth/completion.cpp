@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <type_traits>
 
 namespace rgbl {
@@ -273,7 +274,7 @@ RGBL_CLONES_AVX2 void combine_rows(const std::int32_t* const* sources, int count
 // share the row runs (widths 1, 3, 5) built in registers. S is the key vector: 8 lanes (AVX2 or
 // baseline) or 16 (AVX-512, whose 32 registers hold a pass's 30 runs). Fusing removed a conversion
 // pass that took a third of the time.
-constexpr int kDiamondGroup = 8;  // output rows per pass (4: 7% slower, 16: spills)
+constexpr int kDiamondGroup = 8;  // output rows per pass (measured before fusing: 4 was 7% slower, 16 spilled)
 constexpr int kMaxLanes = 16;
 
 using Keys16 = std::int32_t __attribute__((vector_size(64)));
@@ -373,13 +374,14 @@ void dilate_diamond5(const cv::Mat_<float>& sparse, const Inversion& inv, std::i
   // Everything else (the image's first and last rows, the columns left of xa and right of xb) goes
   // through a zero-padded copy of the G + 4 rows, computed into a scratch output and copied out.
   const int scratch_cols = width + 4 + 2 * kMaxLanes;
-  std::vector<float> scratch_in(static_cast<std::size_t>(G + 4) * static_cast<std::size_t>(scratch_cols), 0.0F);
-  std::vector<float> scratch_out(static_cast<std::size_t>(G) * static_cast<std::size_t>(scratch_cols), 0.0F);
+  // (not zeroed here: padded() clears what each pass reads)
+  const auto scratch_in = std::make_unique_for_overwrite<float[]>(static_cast<std::size_t>((G + 4) * scratch_cols));
+  const auto scratch_out = std::make_unique_for_overwrite<float[]>(static_cast<std::size_t>(G * scratch_cols));
   auto padded = [&](int y, int c0, int c1) {  // output columns [c0, c1) of rows y .. y + G - 1
     const int cols = c1 - c0;
     const int used = cols + 4 + kMaxLanes;  // what the pass reads of each scratch row
     for (int i = 0; i < G + 4; ++i) {
-      float* dst = &scratch_in[static_cast<std::size_t>(i * scratch_cols)];
+      float* dst = scratch_in.get() + static_cast<std::ptrdiff_t>(i) * scratch_cols;
       std::fill(dst, dst + used, 0.0F);
       const int r = y - 2 + i;
       if (r < 0 || r >= height) continue;
@@ -387,15 +389,15 @@ void dilate_diamond5(const cv::Mat_<float>& sparse, const Inversion& inv, std::i
       std::memcpy(dst + 2 + (s0 - c0), sparse[r] + s0, sizeof(float) * static_cast<std::size_t>(s1 - s0));
     }
     DiamondBlock b = block;
-    b.in = scratch_in.data() + 2;
+    b.in = scratch_in.get() + 2;
     b.in_step = scratch_cols;
-    b.out = scratch_out.data();
+    b.out = scratch_out.get();
     b.out_step = scratch_cols;
     b.x0 = 0;
     b.x1 = cols;
     diamond5(b);
     for (int j = 0; j < G && y + j < height; ++j) {
-      std::memcpy(dense[y + j] + c0, &scratch_out[static_cast<std::size_t>(j * scratch_cols)],
+      std::memcpy(dense[y + j] + c0, scratch_out.get() + static_cast<std::ptrdiff_t>(j) * scratch_cols,
                   sizeof(float) * static_cast<std::size_t>(cols));
     }
   };

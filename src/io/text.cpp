@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <system_error>
 
 namespace rgbl::detail {
@@ -45,6 +46,29 @@ std::ifstream open_for_reading(const std::filesystem::path& file, std::string_vi
   std::ifstream in(file);
   if (!in) throw ParseError(file, 0, fmt::format("cannot open the file (expected {})", what));
   return in;
+}
+
+void for_each_record(const std::filesystem::path& file, std::string_view what, std::size_t count,
+                     std::string_view record,
+                     const std::function<void(std::size_t line_no, std::span<const double> numbers)>& on_record) {
+  auto in = open_for_reading(file, what);
+  std::vector<double> numbers(count);
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (is_comment_or_blank(line)) continue;
+    const auto tokens = split(line);
+    if (tokens.size() != count) {
+      throw ParseError(file, line_no, fmt::format("expected {}, found {} fields", record, tokens.size()));
+    }
+    for (std::size_t k = 0; k < count; ++k) {
+      if (!parse_double(tokens[k], numbers[k]) || !std::isfinite(numbers[k])) {
+        throw ParseError(file, line_no, fmt::format("field {} '{}' is not a finite number", k + 1, tokens[k]));
+      }
+    }
+    on_record(line_no, numbers);
+  }
 }
 
 void write_atomically(const std::filesystem::path& file, const std::function<void(std::ofstream&)>& write) {

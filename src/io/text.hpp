@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -19,6 +20,14 @@ bool is_comment_or_blank(std::string_view line);
 
 // Opens a text file for reading or throws ParseError(file, 0, "cannot open ... (expected <what>)").
 std::ifstream open_for_reading(const std::filesystem::path& file, std::string_view what);
+
+// Reads a file of numeric records, one per line (blank lines and '#' comments skipped): calls
+// on_record(line_no, numbers) with exactly `count` finite numbers, or throws ParseError(file, line,
+// "expected <record>, found N fields") / ("field K '...' is not a finite number"). `what` describes
+// the file for open_for_reading.
+void for_each_record(const std::filesystem::path& file, std::string_view what, std::size_t count,
+                     std::string_view record,
+                     const std::function<void(std::size_t line_no, std::span<const double> numbers)>& on_record);
 
 // Calls write(stream) on a temporary file next to `file`, then renames it into place; on failure
 // removes the temporary and throws Error naming `file`.

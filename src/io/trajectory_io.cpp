@@ -38,32 +38,16 @@ void write_kitti_trajectory(const std::filesystem::path& file, std::span<const E
 }
 
 std::vector<Eigen::Isometry3d> read_kitti_trajectory(const std::filesystem::path& file) {
-  auto in = detail::open_for_reading(file, "a KITTI trajectory: 12 numbers per line");
   std::vector<Eigen::Isometry3d> poses;
-  std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (detail::is_comment_or_blank(line)) continue;
-    const auto tokens = detail::split(line);
-    if (tokens.size() != 12) {
-      throw ParseError(file, line_no,
-                       fmt::format("expected 12 numbers (a row-major 3x4 pose), found {} fields", tokens.size()));
-    }
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    for (int k = 0; k < 12; ++k) {
-      double v = 0.0;
-      const auto token = tokens[static_cast<std::size_t>(k)];
-      if (!detail::parse_double(token, v) || !std::isfinite(v)) {
-        throw ParseError(file, line_no, fmt::format("field {} '{}' is not a finite number", k + 1, token));
-      }
-      T.matrix()(k / 4, k % 4) = v;
-    }
-    if (!is_rotation(T.linear())) {
-      throw ParseError(file, line_no, "the left 3x3 block is not a rotation matrix");
-    }
-    poses.push_back(T);
-  }
+  detail::for_each_record(file, "a KITTI trajectory: 12 numbers per line", 12, "12 numbers (a row-major 3x4 pose)",
+                          [&](std::size_t line_no, std::span<const double> v) {
+                            Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+                            for (int k = 0; k < 12; ++k) T.matrix()(k / 4, k % 4) = v[static_cast<std::size_t>(k)];
+                            if (!is_rotation(T.linear())) {
+                              throw ParseError(file, line_no, "the left 3x3 block is not a rotation matrix");
+                            }
+                            poses.push_back(T);
+                          });
   return poses;
 }
 
@@ -85,38 +69,24 @@ void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& t
 }
 
 Trajectory read_tum_trajectory(const std::filesystem::path& file) {
-  auto in = detail::open_for_reading(file, "a TUM trajectory: 't tx ty tz qx qy qz qw' per line");
   Trajectory trajectory;
-  std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (detail::is_comment_or_blank(line)) continue;
-    const auto tokens = detail::split(line);
-    if (tokens.size() != 8) {
-      throw ParseError(file, line_no,
-                       fmt::format("expected 8 numbers 't tx ty tz qx qy qz qw', found {} fields", tokens.size()));
-    }
-    double v[8];
-    for (std::size_t k = 0; k < 8; ++k) {
-      if (!detail::parse_double(tokens[k], v[k]) || !std::isfinite(v[k])) {
-        throw ParseError(file, line_no, fmt::format("field {} '{}' is not a finite number", k + 1, tokens[k]));
-      }
-    }
-    Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-    if (std::abs(q.norm() - 1.0) > 1e-3) {
-      throw ParseError(file, line_no, fmt::format("quaternion norm is {}, expected 1", q.norm()));
-    }
-    if (!trajectory.timestamps.empty() && v[0] <= trajectory.timestamps.back()) {
-      throw ParseError(file, line_no, "timestamps must increase");
-    }
-    q.normalize();
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = q.toRotationMatrix();
-    T.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
-    trajectory.timestamps.push_back(v[0]);
-    trajectory.poses.push_back(T);
-  }
+  detail::for_each_record(
+      file, "a TUM trajectory: 't tx ty tz qx qy qz qw' per line", 8, "8 numbers 't tx ty tz qx qy qz qw'",
+      [&](std::size_t line_no, std::span<const double> v) {
+        Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+        if (std::abs(q.norm() - 1.0) > 1e-3) {
+          throw ParseError(file, line_no, fmt::format("quaternion norm is {}, expected 1", q.norm()));
+        }
+        if (!trajectory.timestamps.empty() && v[0] <= trajectory.timestamps.back()) {
+          throw ParseError(file, line_no, "timestamps must increase");
+        }
+        q.normalize();
+        Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+        T.linear() = q.toRotationMatrix();
+        T.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+        trajectory.timestamps.push_back(v[0]);
+        trajectory.poses.push_back(T);
+      });
   return trajectory;
 }
 

@@ -248,27 +248,8 @@ int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t
   std::vector<PoseObservation> observations;
   std::vector<std::size_t> keypoint_of;
   observations.reserve(frame.size());
-  {
-    std::shared_lock lock(map_.mutex());
-    for (std::size_t i = 0; i < frame.size(); ++i) {
-      const Landmark* l = frame.landmarks[i].valid() ? map_.landmark(frame.landmarks[i]) : nullptr;
-      if (l == nullptr) {
-        frame.landmarks[i] = LandmarkId{};
-        continue;
-      }
-      PoseObservation o;
-      o.p_world = l->position;
-      o.pixel = Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y);
-      o.sigma_px = level_scale(map_, frame.keypoints[i].level);
-      if (frame.depth_sigma[i] > 0.0F && frame.depth[i] < options_.close_depth) {
-        o.depth = frame.depth[i];
-        o.depth_sigma = frame.depth_sigma[i];
-      }
-      observations.push_back(o);
-      keypoint_of.push_back(i);
-    }
-  }
-  for (const auto& [i, p_world] : extra) {
+  // Keypoint i seeing p_world, with its LiDAR depth where that is close enough to constrain the pose.
+  auto add = [&](std::size_t i, const Eigen::Vector3d& p_world) {
     PoseObservation o;
     o.p_world = p_world;
     o.pixel = Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y);
@@ -279,7 +260,19 @@ int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t
     }
     observations.push_back(o);
     keypoint_of.push_back(i);
+  };
+  {
+    std::shared_lock lock(map_.mutex());
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      const Landmark* l = frame.landmarks[i].valid() ? map_.landmark(frame.landmarks[i]) : nullptr;
+      if (l == nullptr) {
+        frame.landmarks[i] = LandmarkId{};
+        continue;
+      }
+      add(i, l->position);
+    }
   }
+  for (const auto& [i, p_world] : extra) add(i, p_world);
   if (observations.size() < static_cast<std::size_t>(options_.min_pose_inliers)) return 0;
   const PoseOptimizerResult result = optimize_pose(camera_, frame.T_cam_world, observations, options_.pose);
   frame.T_cam_world = result.T_cam_world;

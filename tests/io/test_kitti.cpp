@@ -1,6 +1,7 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/io/sequence.hpp"
 #include "support/data.hpp"
+#include "support/parse_error.hpp"
 #include "synthetic.hpp"
 
 #include <catch2/catch.hpp>
@@ -14,17 +15,7 @@ using Catch::Matchers::WithinAbs;
 
 namespace {
 
-template <typename F>
-std::string parse_error_message(F&& f, const std::filesystem::path& file) {
-  try {
-    f();
-  } catch (const rgbl::ParseError& e) {
-    CHECK(e.file() == file);
-    return e.what();
-  }
-  FAIL("no ParseError for " << file.string());
-  return {};
-}
+using rgbl::test::parse_error_message;
 
 }  // namespace
 

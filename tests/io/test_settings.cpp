@@ -1,5 +1,6 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/io/settings.hpp"
+#include "support/parse_error.hpp"
 #include "support/temp_dir.hpp"
 
 #include <catch2/catch.hpp>
@@ -60,14 +61,12 @@ std::string replace(std::string text, const std::string& from, const std::string
 }
 
 std::string error_of(const std::filesystem::path& file) {
-  try {
-    rgbl::read_settings(file);
-  } catch (const rgbl::ParseError& e) {
-    CHECK(e.file() == file);
-    return e.what();
-  }
-  FAIL("no ParseError for " << file.string());
-  return {};
+  return rgbl::test::parse_error_message([&] { rgbl::read_settings(file); }, file);
+}
+
+// The reference file with one more ORBextractor line.
+std::string with_orb_line(const std::string& line) {
+  return replace(kRgblYaml, "ORBextractor.minThFAST: 7", "ORBextractor.minThFAST: 7\n" + line);
 }
 
 }  // namespace
@@ -147,11 +146,9 @@ TEST_CASE("settings: wrong types, incomplete groups and bad values name file and
   CHECK_THAT(
       error_of(tmp.write("h.yaml", replace(kRgblYaml, "ORBextractor.minThFAST: 7", "ORBextractor.minThFAST: 30"))),
       Contains("ORBextractor.minThFAST"));
-  CHECK_THAT(error_of(tmp.write("h2.yaml", replace(kRgblYaml, "ORBextractor.minThFAST: 7",
-                                                   "ORBextractor.minThFAST: 7\nORBextractor.featuresPerNode: 0"))),
+  CHECK_THAT(error_of(tmp.write("h2.yaml", with_orb_line("ORBextractor.featuresPerNode: 0"))),
              Contains("'ORBextractor.featuresPerNode': expected a count >= 1"));
-  CHECK_THAT(error_of(tmp.write("h3.yaml", replace(kRgblYaml, "ORBextractor.minThFAST: 7",
-                                                   "ORBextractor.minThFAST: 7\nORBextractor.spreadFraction: 1.5"))),
+  CHECK_THAT(error_of(tmp.write("h3.yaml", with_orb_line("ORBextractor.spreadFraction: 1.5"))),
              Contains("'ORBextractor.spreadFraction': expected a fraction in (0, 1]"));
   CHECK_THAT(error_of(tmp.write("i.yaml", replace(kRgblYaml, "LiDAR.Tr11: -1.857739385241e-03", "LiDAR.Tr11: 2.0"))),
              Contains("rotation matrix"));
