@@ -102,6 +102,7 @@ Command add_depth_command(CLI::App& parent) {
             ReadAheadOptions read;
             read.first = p.first;
             read.count = p.count;
+            read.step = p.step;
             ReadAhead reader(*p.sequence, read);
             while (auto input = reader.next()) {
               Stopwatch watch;

@@ -114,6 +114,8 @@ void add_input_options(CLI::App& app, InputOptions& options) {
   app.add_option("--config", options.config, "Settings YAML (ORB-SLAM style; RGB-L LiDAR.* keys accepted)");
   app.add_option("--frames", options.frames, "Number of frames to process (default: all)");
   app.add_option("--first", options.first, "First frame to process");
+  app.add_option("--step", options.step, "Process every N-th frame (e.g. 2: KITTI at 5 Hz)")
+      ->check(CLI::PositiveNumber);
 }
 
 Pipeline make_pipeline(const InputOptions& options) {
@@ -159,8 +161,11 @@ Pipeline make_pipeline(const InputOptions& options) {
   if (options.first >= size) {
     throw ConfigError("--first", fmt::format("a frame index below {} (the sequence's length)", size));
   }
+  if (options.step < 1) throw ConfigError("--step", "a stride of at least 1 frame");
   p.first = options.first;
-  p.count = options.frames == 0 ? size - p.first : std::min(options.frames, size - p.first);
+  p.step = options.step;
+  const std::size_t available = (size - p.first + p.step - 1) / p.step;
+  p.count = options.frames == 0 ? available : std::min(options.frames, available);
   p.orb.validate();
   p.system.validate();
   // creating the source once validates its options before any frame is read

@@ -24,6 +24,7 @@ struct InputOptions {
   int camera = -1;         // -1: camera 2 when the dataset has it, else 0
   std::size_t frames = 0;  // 0 = all
   std::size_t first = 0;
+  std::size_t step = 1;    // every step-th frame
   std::string depth = "lidar";
   std::string config;      // ORB-SLAM / RGB-L style settings YAML
 };
@@ -40,7 +41,8 @@ struct Pipeline {
   DepthSourceSettings depth_settings;
   SystemOptions system;
   OrbOptions orb;
-  std::size_t first = 0, count = 0;  // frames to process
+  std::size_t first = 0, count = 0;  // frames to process: first, first + step, ... (count of them)
+  std::size_t step = 1;
   std::vector<std::string> notes;    // decisions made on the user's behalf, printed once
 
   std::unique_ptr<DepthSource> make_depth_source() const;

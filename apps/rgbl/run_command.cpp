@@ -102,6 +102,7 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
   ReadAheadOptions read_options;
   read_options.first = p.first;
   read_options.count = p.count;
+  read_options.step = p.step;
   ReadAhead frames(*p.sequence, read_options);
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   std::vector<FrameRecord> records;
@@ -176,9 +177,9 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
   // metrics against ground truth over the frames it covers
   std::vector<Eigen::Isometry3d> est_poses, gt_poses;
   if (gt) {
-    for (std::size_t i = 0; i < estimate.poses.size() && p.first + i < gt->size(); ++i) {
+    for (std::size_t i = 0; i < estimate.poses.size() && p.first + i * p.step < gt->size(); ++i) {
       est_poses.push_back(estimate.poses[i]);
-      gt_poses.push_back(gt->poses[p.first + i]);
+      gt_poses.push_back(gt->poses[p.first + i * p.step]);
     }
   }
   std::string metrics_json = "null";
@@ -280,6 +281,7 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
          << fmt::format("  \"sequence\": {},\n  \"format\": {},\n  \"camera\": {},\n  \"depth\": {},\n",
                         json_string(p.sequence->path().string()), json_string(std::string(to_string(p.sequence->format()))),
                         p.camera, json_string(p.depth_name))
+         << fmt::format("  \"first_frame\": {},\n  \"step\": {},\n", p.first, p.step)
          << fmt::format("  \"frames\": {},\n  \"tracked\": {},\n  \"lost\": {},\n  \"not_initialised\": {},\n"
                         "  \"lost_frames\": [{}],\n  \"new_map_frames\": [{}],\n  \"keyframes\": {},\n"
                         "  \"landmarks\": {},\n",

@@ -8,13 +8,16 @@ namespace rgbl {
 
 void ReadAheadOptions::validate() const {
   require(depth >= 1, "read_ahead.depth", "at least 1 frame");
+  require(step >= 1, "read_ahead.step", "at least 1 (every frame)");
 }
 
 ReadAhead::ReadAhead(const Sequence& sequence, const ReadAheadOptions& options)
-    : sequence_(sequence), depth_(options.depth), first_(std::min(options.first, sequence.size())) {
+    : sequence_(sequence), depth_(options.depth), first_(std::min(options.first, sequence.size())),
+      step_(options.step) {
   options.validate();
-  const std::size_t available = sequence.size() - first_;
-  end_ = first_ + (options.count == 0 ? available : std::min(options.count, available));
+  const std::size_t available = (sequence.size() - first_ + step_ - 1) / step_;  // frames on the stride
+  const std::size_t count = options.count == 0 ? available : std::min(options.count, available);
+  end_ = count == 0 ? first_ : first_ + (count - 1) * step_ + 1;
   thread_ = std::thread([this] { run(); });
 }
 
@@ -28,7 +31,7 @@ ReadAhead::~ReadAhead() {
 }
 
 void ReadAhead::run() {
-  for (std::size_t i = first_; i < end_; ++i) {
+  for (std::size_t i = first_; i < end_; i += step_) {
     {
       std::unique_lock lock(mutex_);
       changed_.wait(lock, [this] { return stop_ || queue_.size() < depth_; });

@@ -5,7 +5,7 @@ file(REMOVE_RECURSE ${WORK_DIR})
 
 function(run_and_check name dir frames)
   set(out ${WORK_DIR}/${name})
-  execute_process(COMMAND ${RGBL} -q run ${dir} --out ${out} RESULT_VARIABLE rc OUTPUT_VARIABLE stdout
+  execute_process(COMMAND ${RGBL} -q run ${dir} --out ${out} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE stdout
                   ERROR_VARIABLE stderr)
   message("${stdout}${stderr}")
   if(NOT rc EQUAL 0)
@@ -46,6 +46,15 @@ endfunction()
 
 run_and_check(seq04 ${data}/odometry/sequences/04 51)
 run_and_check(raw0009 ${data}/raw/2011_09_26/2011_09_26_drive_0009_sync 10)
+# 5 Hz from frame 10: 10, 12, ..., 50. A trajectory paired with the wrong ground-truth rows would be
+# metres off (2.8 m steps), so the ATE bound also checks the pairing.
+run_and_check(seq04_step2 ${data}/odometry/sequences/04 21 --first 10 --step 2)
+file(READ ${WORK_DIR}/seq04_step2/summary.json summary)
+string(JSON step GET "${summary}" step)
+string(JSON first GET "${summary}" first_frame)
+if(NOT step EQUAL 2 OR NOT first EQUAL 10)
+  message(FATAL_ERROR "summary.json: step ${step}, first_frame ${first}; expected 2 and 10")
+endif()
 
 set(out ${WORK_DIR}/depth04)
 execute_process(COMMAND ${RGBL} -q depth ${data}/odometry/sequences/04 --frames 5 --out ${out}

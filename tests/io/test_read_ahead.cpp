@@ -75,6 +75,24 @@ TEST_CASE("read-ahead honours first and count", "[io][read-ahead]") {
   CHECK_FALSE(past_end.next());
 }
 
+TEST_CASE("read-ahead honours a step, with first and count, and skips the frames between", "[io][read-ahead]") {
+  CountingSequence seq(10, 1000);
+  rgbl::ReadAhead every_third(seq, {2, 1, 0, 3});
+  CHECK(every_third.next()->index == 1);
+  CHECK(every_third.next()->index == 4);
+  CHECK(every_third.next()->index == 7);
+  CHECK_FALSE(every_third.next());  // 10 is past the end
+  CHECK(seq.loads == 3);            // frames between are never loaded
+  rgbl::ReadAhead counted(seq, {2, 0, 2, 4});
+  CHECK(counted.next()->index == 0);
+  CHECK(counted.next()->index == 4);
+  CHECK_FALSE(counted.next());
+  rgbl::ReadAhead last_only(seq, {2, 9, 0, 5});
+  CHECK(last_only.next()->index == 9);
+  CHECK_FALSE(last_only.next());
+  CHECK_THROWS_WITH(rgbl::ReadAhead(seq, {2, 0, 0, 0}), Contains("read_ahead.step"));
+}
+
 TEST_CASE("read-ahead forwards a load error on the frame that failed", "[io][read-ahead]") {
   CountingSequence seq(10, 3);
   rgbl::ReadAhead reader(seq, {4, 0, 0});

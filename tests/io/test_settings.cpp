@@ -1,4 +1,5 @@
 #include "rgbl/core/error.hpp"
+#include "rgbl/features/orb.hpp"
 #include "rgbl/io/settings.hpp"
 #include "support/parse_error.hpp"
 #include "support/temp_dir.hpp"
@@ -122,6 +123,12 @@ TEST_CASE("settings: a minimal file gives the defaults", "[io][settings]") {
   CHECK_FALSE(s.T_cam_lidar);
   CHECK(s.orb.n_features == 1500);
   CHECK(s.orb.n_levels == 8);
+  // Keys the file leaves out are the extractor's own defaults: a settings file changes only what it names.
+  const rgbl::OrbOptions orb;
+  CHECK(s.orb.ini_th_fast == orb.fast_threshold);
+  CHECK(s.orb.min_th_fast == orb.fast_min_threshold);
+  CHECK(s.orb.scale_factor == Approx(orb.scale_factor));
+  CHECK(s.orb.n_levels == orb.num_levels);
   CHECK(s.projection.min_depth == 5.0F);
   CHECK(s.kernel_size == 0);
   CHECK(s.warnings.empty());

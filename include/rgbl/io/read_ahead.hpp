@@ -18,11 +18,12 @@ struct ReadAheadOptions {
   std::size_t depth = 3;  // frames loaded ahead of the one the caller holds (queue bound), >= 1
   std::size_t first = 0;  // first frame index
   std::size_t count = 0;  // frames to deliver; 0 = up to the end of the sequence
+  std::size_t step = 1;   // deliver every step-th frame (first, first + step, ...), >= 1
 
   void validate() const;
 };
 
-// next() returns frames first, first+1, ... in order and nullopt after the last one. A frame whose
+// next() returns frames first, first+step, ... in order and nullopt after the last one. A frame whose
 // load threw rethrows that exception from next() when its turn comes (earlier frames are delivered
 // first), and nothing is loaded after it. The destructor stops the loader and joins it, also when
 // the caller leaves early. The sequence must outlive this object.
@@ -45,6 +46,7 @@ class ReadAhead {
   const Sequence& sequence_;
   std::size_t depth_;
   std::size_t first_;
+  std::size_t step_;
   std::size_t end_;
   std::mutex mutex_;
   std::condition_variable changed_;

@@ -27,7 +27,7 @@ struct OrbSettings {
   int n_features = 2000;
   double scale_factor = 1.2;
   int n_levels = 8;
-  int ini_th_fast = 20;
+  int ini_th_fast = 12;  // absent keys keep OrbOptions' defaults (SPEC 5), not ORB-SLAM's 20
   int min_th_fast = 7;
   // rgbl's own key ORBextractor.featuresPerNode (OrbOptions::features_per_node); unset = the default.
   std::optional<int> features_per_node;
