@@ -22,7 +22,17 @@ void TrackerOptions::validate() const {
           "in [0, 1]");
   require(verify_min_motion_ratio >= 0.0 && verify_min_motion_ratio <= 1.0, "tracker.verify_min_motion_ratio",
           "in [0, 1]");
+  require(relocalisation_min_found_ratio >= 0.0 && relocalisation_min_found_ratio <= 1.0,
+          "tracker.relocalisation_min_found_ratio", "in [0, 1]");
   require(relocalisation_min_matches >= 6, "tracker.relocalisation_min_matches", ">= 6 (PnP RANSAC)");
+  require(ransac_iterations >= 1, "tracker.ransac_iterations", ">= 1");
+  require(ransac_min_inliers >= 3, "tracker.ransac_min_inliers", ">= 3 (a rigid motion needs 3 points)");
+  require(ransac_guess_min_inliers >= 3, "tracker.ransac_guess_min_inliers", ">= 3 (a rigid motion needs 3 points)");
+  require(ransac_coverage_cell >= 0.0, "tracker.ransac_coverage_cell", ">= 0 px (0 = rank by size only)");
+  require(ransac_prior_translation >= 0.0, "tracker.ransac_prior_translation", ">= 0 m");
+  require(ransac_prior_relative >= 0.0, "tracker.ransac_prior_relative", ">= 0");
+  require(ransac_prior_rotation_deg >= 0.0 && ransac_prior_rotation_deg <= 180.0, "tracker.ransac_prior_rotation_deg",
+          "in [0, 180] degrees");
   require(max_frames_between_keyframes >= 1, "tracker.max_frames_between_keyframes", ">= 1");
   require(close_depth > 0.0, "tracker.close_depth", "> 0");
   pose.validate();

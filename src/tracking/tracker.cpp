@@ -4,11 +4,11 @@
 #include "rgbl/backend/pose_optimizer.hpp"
 #include "rgbl/core/log.hpp"
 #include "rgbl/geometry/se3.hpp"
+#include "rgbl/tracking/frame_motion.hpp"
 
 #include <opencv2/calib3d.hpp>
 
 #include <algorithm>
-#include <random>
 #include <cmath>
 #include <mutex>
 #include <shared_mutex>
@@ -68,6 +68,7 @@ void discard_outliers(Frame& frame) {
 
 TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   TrackerOutcome outcome;
+  const TrackState previous_state = state_;
   frame.landmarks.assign(frame.size(), LandmarkId{});
   frame.outlier.assign(frame.size(), false);
   auto count_tracked = [](const Frame& f) {
@@ -82,6 +83,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     outcome.state = state_;
     last_frame_ = frame;
     last_frame_->grid = FeatureGrid();
+    last_tracked_frame_.reset();
     return outcome;
   };
   if (state_ == TrackState::NotInitialised) {
@@ -106,7 +108,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   bool recent_loss = false;
   if (state_ == TrackState::Ok) {
     if (velocity_ && last_frame_) {
-      motion_inliers = track_with_motion_model(frame);
+      motion_inliers = track_with_motion_model(frame, *last_frame_, *velocity_ * last_frame_->T_cam_world);
       ok = motion_ok = motion_inliers >= options_.min_pose_inliers;
     }
     if (!ok) {
@@ -118,7 +120,10 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     // and keeps the trajectory continuous; otherwise relocalise against the whole map.
     recent_loss = velocity_ && last_frame_ && frame.index <= last_ok_frame_ + options_.recent_loss_frames;
     if (recent_loss) {
-      motion_inliers = track_with_motion_model(frame);
+      // Against the last tracked frame (the frames since carry only guesses and maybe no features,
+      // e.g. black images), from the guess over the time elapsed.
+      const Frame& reference = last_tracked_frame_ ? *last_tracked_frame_ : *last_frame_;
+      motion_inliers = track_with_motion_model(frame, reference, T_predicted);
       ok = motion_ok = motion_inliers >= options_.min_pose_inliers;
       if (!ok) clear_matches(frame);
     }
@@ -136,6 +141,12 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     const Frame after_motion = motion_ok ? frame : Frame{};
     local = track_local_map(frame);
     ok = local.ok;
+    if (ok && outcome.relocalised && !relocalisation_confirmed(local)) {
+      logger()->debug("frame {}: relocalisation rejected, the local map re-finds {} of {} points", frame.index,
+                      local.inliers, local.visible);
+      ok = false;
+      outcome.relocalised = false;
+    }
     is_suspect = motion_ok && suspect(motion_inliers, local);
     if (!ok && motion_ok && options_.keep_weak_tracking && !is_suspect) {
       // The map is thin here (e.g. mapping lags behind) but frame-to-frame motion held: keep the
@@ -156,7 +167,9 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     const std::size_t last_relocalisation = last_relocalisation_frame_;
     Frame candidate = frame;  // tracking changed only its pose and matches
     clear_matches(candidate);
-    const bool relocalised = relocalise(candidate) && track_local_map(candidate).ok;
+    const bool relocalised_pnp = relocalise(candidate);
+    const LocalMapResult candidate_local = relocalised_pnp ? track_local_map(candidate) : LocalMapResult{};
+    const bool relocalised = relocalised_pnp && candidate_local.ok && relocalisation_confirmed(candidate_local);
     const int candidate_inliers = relocalised ? count_tracked(candidate) : 0;
     if (relocalised && candidate_inliers > inliers) {
       frame = std::move(candidate);
@@ -178,17 +191,20 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
     }
   }
   if (ok) {
+    const bool consecutive = state_ == TrackState::Ok;  // the previous frame was tracked too
     state_ = TrackState::Ok;
     last_ok_frame_ = frame.index;
     last_inliers_ = inliers;
     if (last_frame_) {
       velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
       velocity_dt_ = frame.timestamp - last_frame_->timestamp;
+      velocity_steady_ = consecutive && motion_ok && !outcome.relocalised;
     }
     outcome.need_keyframe = weak || need_keyframe(frame, inliers, mapping_idle);
   } else {
     const bool was_lost = state_ == TrackState::Lost;
     state_ = TrackState::Lost;
+    velocity_steady_ = false;
     inliers = 0;
     last_inliers_ = 0;
     frame.T_cam_world = T_predicted;  // best guess, reported with state Lost
@@ -204,6 +220,11 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   }
   outcome.state = state_;
   outcome.inliers = inliers;
+  if (state_ == TrackState::Ok) {
+    last_tracked_frame_.reset();
+  } else if (previous_state == TrackState::Ok && last_frame_) {
+    last_tracked_frame_ = std::move(last_frame_);  // the first lost frame: keep the last tracked one
+  }
   last_frame_ = frame;
   last_frame_->grid = FeatureGrid();
   return outcome;
@@ -219,6 +240,11 @@ bool Tracker::suspect(int motion_inliers, const LocalMapResult& local) const {
   const bool map_disagrees = found_needed >= floor && local.inliers < found_needed;
   const bool motion_collapsed = motion_needed >= floor && motion_inliers < motion_needed;
   return map_disagrees || motion_collapsed;
+}
+
+bool Tracker::relocalisation_confirmed(const LocalMapResult& local) const {
+  const double needed = options_.relocalisation_min_found_ratio * local.visible;
+  return needed < options_.min_pose_inliers || local.inliers >= needed;  // judged as suspect() judges
 }
 
 bool Tracker::initialise(Frame& frame, const Eigen::Isometry3d& T_cam_world) {
@@ -280,89 +306,23 @@ int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t
   return result.inliers;
 }
 
-namespace {
-
-// Frame-to-frame motion from depth on both sides, independent of any prediction: brute-force matching
-// (ratio test) between keypoints with depth, then a 3-point RANSAC on the rigid 3-D alignment. Breaks
-// the feedback of the constant-velocity prediction on periodic or weak texture (fences, grass), where
-// guided matching around a slightly wrong prediction finds matches that confirm it.
-std::optional<Eigen::Isometry3d> depth_motion_ransac(const PinholeCamera& camera, const Frame& last, const Frame& frame,
-                                                     const TrackerOptions& options) {
-  std::vector<Descriptor> last_desc, cur_desc;
-  std::vector<Eigen::Vector3d> last_pts, cur_pts;
-  for (std::size_t i = 0; i < last.size(); ++i) {
-    if (last.depth_sigma[i] <= 0.0F) continue;
-    last_desc.push_back(last.descriptors[i]);
-    last_pts.push_back(camera.unproject(Eigen::Vector2d(last.keypoints[i].x, last.keypoints[i].y), last.depth[i]));
-  }
-  // A strided subset of the current keypoints is enough for a 6-DoF consensus and bounds the cost.
-  std::size_t with_depth = 0;
-  for (std::size_t i = 0; i < frame.size(); ++i) with_depth += frame.depth_sigma[i] > 0.0F ? 1 : 0;
-  const std::size_t stride = std::max<std::size_t>(1, (with_depth + options.ransac_max_points - 1) /
-                                                          std::max<std::size_t>(1, options.ransac_max_points));
-  std::size_t seen = 0;
-  for (std::size_t i = 0; i < frame.size(); ++i) {
-    if (frame.depth_sigma[i] <= 0.0F) continue;
-    if (seen++ % stride != 0) continue;
-    cur_desc.push_back(frame.descriptors[i]);
-    cur_pts.push_back(camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y), frame.depth[i]));
-  }
-  const auto matches = detail::match_brute_force(cur_desc, last_desc, options.ransac_max_hamming, options.ransac_ratio);
-  const int n = static_cast<int>(matches.size());
-  if (n < options.ransac_min_inliers) return std::nullopt;
-  auto fit = [&](const std::vector<int>& idx) {
-    Eigen::Matrix3Xd a(3, static_cast<Eigen::Index>(idx.size())), b(3, static_cast<Eigen::Index>(idx.size()));
-    for (std::size_t k = 0; k < idx.size(); ++k) {
-      const auto& [q, t] = matches[static_cast<std::size_t>(idx[k])];
-      a.col(static_cast<Eigen::Index>(k)) = last_pts[static_cast<std::size_t>(t)];
-      b.col(static_cast<Eigen::Index>(k)) = cur_pts[static_cast<std::size_t>(q)];
-    }
-    Eigen::Isometry3d T;
-    T.matrix() = Eigen::umeyama(a, b, false);
-    return T;
-  };
-  auto inliers_of = [&](const Eigen::Isometry3d& T, std::vector<int>& out) {
-    out.clear();
-    for (int m = 0; m < n; ++m) {
-      const auto& [q, t] = matches[static_cast<std::size_t>(m)];
-      const Eigen::Vector3d& pc = cur_pts[static_cast<std::size_t>(q)];
-      const double tolerance = std::max(options.ransac_min_tolerance, options.ransac_relative_tolerance * pc.z());
-      if ((T * last_pts[static_cast<std::size_t>(t)] - pc).norm() < tolerance) out.push_back(m);
-    }
-  };
-  std::mt19937 rng(7);  // fixed seed: deterministic
-  std::uniform_int_distribution<int> pick(0, n - 1);
-  std::vector<int> best, current;
-  for (int it = 0; it < options.ransac_iterations; ++it) {
-    std::vector<int> sample = {pick(rng), pick(rng), pick(rng)};
-    if (sample[0] == sample[1] || sample[1] == sample[2] || sample[0] == sample[2]) continue;
-    inliers_of(fit(sample), current);
-    if (current.size() > best.size()) best.swap(current);
-  }
-  if (static_cast<int>(best.size()) < options.ransac_min_inliers) return std::nullopt;
-  Eigen::Isometry3d T = fit(best);
-  inliers_of(T, best);
-  if (static_cast<int>(best.size()) < options.ransac_min_inliers) return std::nullopt;
-  return fit(best);
-}
-
-}  // namespace
-
-int Tracker::track_with_motion_model(Frame& frame) {
-  frame.T_cam_world = *velocity_ * last_frame_->T_cam_world;
+int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const Eigen::Isometry3d& T_guess) {
+  frame.T_cam_world = T_guess;
   if (options_.ransac_prediction) {
-    if (const auto T_cur_last = depth_motion_ransac(camera_, *last_frame_, frame, options_)) {
-      frame.T_cam_world = *T_cur_last * last_frame_->T_cam_world;
+    std::optional<Eigen::Isometry3d> prior;
+    if (options_.ransac_motion_prior && velocity_steady_ && &reference == &*last_frame_) prior = velocity_;
+    if (const auto T_cur_last = estimate_frame_motion(camera_, reference, frame, options_, prior)) {
+      frame.T_cam_world = *T_cur_last * reference.T_cam_world;
     }
   }
   std::vector<detail::ProjectedLandmark> candidates;
   std::vector<Eigen::Vector3d> candidate_points;
-  const Eigen::Isometry3d T_world_last = last_frame_->T_cam_world.inverse();
+  const Eigen::Isometry3d T_world_last = reference.T_cam_world.inverse();
   auto build = [&](double radius_factor) {
     candidates.clear();
     candidate_points.clear();
     std::shared_lock lock(map_.mutex());
-    const Frame& last = *last_frame_;
+    const Frame& last = reference;
     for (std::size_t i = 0; i < last.size(); ++i) {
       const bool landmark = last.landmarks[i].valid() && !last.outlier[i];
       const Landmark* l = landmark ? map_.landmark(last.landmarks[i]) : nullptr;
@@ -436,7 +396,18 @@ bool Tracker::track_reference_keyframe(Frame& frame) {
       detail::match_brute_force(frame.descriptors, train, options_.max_hamming, options_.reference_ratio);
   if (static_cast<int>(matches.size()) < 15) return false;
   for (const auto& [q, t] : matches) frame.landmarks[static_cast<std::size_t>(q)] = train_landmarks[static_cast<std::size_t>(t)];
+  // Start from the frame-to-frame motion from depth where there is one (the frame right after
+  // initialisation has no velocity yet, and the last pose is then a poor guess at speed).
   frame.T_cam_world = last_frame_ ? last_frame_->T_cam_world : Eigen::Isometry3d::Identity();
+  if (last_frame_ && options_.ransac_prediction) {
+    std::optional<Eigen::Isometry3d> prior;
+    if (options_.ransac_motion_prior && velocity_steady_) prior = velocity_;
+    TrackerOptions guess_options = options_;  // a guess only: the optimisation below decides
+    guess_options.ransac_min_inliers = options_.ransac_guess_min_inliers;
+    if (const auto T_cur_last = estimate_frame_motion(camera_, *last_frame_, frame, guess_options, prior)) {
+      frame.T_cam_world = *T_cur_last * last_frame_->T_cam_world;
+    }
+  }
   const int inliers = optimise_pose(frame);
   discard_outliers(frame);
   return inliers >= options_.min_pose_inliers;

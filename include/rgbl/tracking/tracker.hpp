@@ -52,12 +52,16 @@ class Tracker {
 
   bool initialise(Frame& frame, const Eigen::Isometry3d& T_cam_world);
   // Returns the pose inliers (landmarks and temporary points), 0 when matching failed.
-  int track_with_motion_model(Frame& frame);
+  // Guided matching against `reference` (the last frame, or after a loss the last tracked one) from
+  // T_guess, refined by the frame-to-frame motion from depth.
+  int track_with_motion_model(Frame& frame, const Frame& reference, const Eigen::Isometry3d& T_guess);
   bool track_reference_keyframe(Frame& frame);
   LocalMapResult track_local_map(Frame& frame);
   // The motion-model hypothesis disagrees with the map or with the recent frames (see TrackerOptions).
   bool suspect(int motion_inliers, const LocalMapResult& local) const;
   bool relocalise(Frame& frame);
+  // The local-map search from a relocalised pose re-finds enough of the points it predicts visible.
+  bool relocalisation_confirmed(const LocalMapResult& local) const;
   // extra: (keypoint, world point) correspondences that are not landmarks (temporary points).
   int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {});
   bool need_keyframe(const Frame& frame, int inliers, bool mapping_idle) const;
@@ -73,8 +77,10 @@ class Tracker {
   std::size_t last_ok_frame_ = 0;
   int last_inliers_ = 0;  // of the last frame if it was tracked, else 0
   std::optional<Frame> last_frame_;
+  std::optional<Frame> last_tracked_frame_;  // while lost: the last frame that was tracked
   std::optional<Eigen::Isometry3d> velocity_;  // T_cur_last
   double velocity_dt_ = 0.0;  // timestamp difference of that pair (0 = unknown)
+  bool velocity_steady_ = false;  // velocity_ comes from two consecutive tracked frames (no relocalisation)
   std::vector<KeyframeId> local_keyframes_;
   std::vector<LandmarkId> local_landmarks_;
 };

@@ -1,0 +1,30 @@
+#pragma once
+// Frame-to-frame rigid motion from depth on both sides: the tracker's prediction before guided
+// matching, usable on its own for RGB-D visual odometry between two frames.
+
+#include "rgbl/geometry/camera.hpp"
+#include "rgbl/tracking/frame.hpp"
+#include "rgbl/tracking/options.hpp"
+
+#include <Eigen/Geometry>
+
+#include <optional>
+
+namespace rgbl {
+
+// T_cur_last (maps points of `last`'s camera into `frame`'s) from brute-force matches (ratio test)
+// between keypoints with usable depth and a 3-point RANSAC on their 3-D alignment (Umeyama), refined
+// on the consensus. Uses options.ransac_*: a strided subset of at most ransac_max_points current
+// keypoints, Hamming <= ransac_max_hamming, ratio ransac_ratio, ransac_iterations samples (fixed seed:
+// deterministic), a point agrees within max(ransac_min_tolerance, ransac_relative_tolerance * z).
+//
+// With a prior (the constant-velocity motion, when trusted) only motions near it count: translation
+// within ransac_prior_translation + ransac_prior_relative * |prior translation| and rotation within
+// ransac_prior_rotation_deg. The prior itself, refined on its own consensus, is the first candidate,
+// so a static scene outnumbered by an object moving with the camera is still found.
+// nullopt: fewer than ransac_min_inliers agree (then the caller keeps its own prediction).
+std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& camera, const Frame& last, const Frame& frame,
+                                                       const TrackerOptions& options,
+                                                       const std::optional<Eigen::Isometry3d>& prior = std::nullopt);
+
+}  // namespace rgbl
