@@ -251,8 +251,8 @@ TEST_CASE("ORB: deterministic, same image gives identical keypoints and descript
 }
 
 TEST_CASE("ORB: keypoints spread, no empty cell of a 4x4 grid", "[features][orb]") {
-  auto check_spread = [](const cv::Mat& img) {
-    const Extracted e = extract(img);
+  auto check_spread = [](const cv::Mat& img, const rgbl::OrbOptions& options) {
+    const Extracted e = extract(img, options);
     int counts[4][4] = {};
     for (const auto& k : e.keypoints) {
       const int cx = std::min(3, static_cast<int>(k.x * 4.0F / static_cast<float>(img.cols)));
@@ -270,10 +270,17 @@ TEST_CASE("ORB: keypoints spread, no empty cell of a 4x4 grid", "[features][orb]
     CHECK(min_count > 0);
     return std::pair{min_count, max_count};
   };
-  // Uniform texture: the quadtree keeps the cells within a factor of 3 of each other.
-  const auto [lo, hi] = check_spread(textured_image(1226, 370));
+  // Uniform texture: the quadtree alone (spread_fraction 1) keeps the cells within a factor of 3 of
+  // each other; the default places half the budget by strength and still leaves no cell empty.
+  rgbl::OrbOptions quadtree_only;
+  quadtree_only.spread_fraction = 1.0;
+  const auto [lo, hi] = check_spread(textured_image(1226, 370), quadtree_only);
   CHECK(lo * 3 >= hi);
-  if (const auto img = kitti_frame()) check_spread(*img);
+  check_spread(textured_image(1226, 370), rgbl::OrbOptions{});
+  if (const auto img = kitti_frame()) {
+    check_spread(*img, rgbl::OrbOptions{});
+    check_spread(*img, quadtree_only);
+  }
 }
 
 TEST_CASE("ORB: spread_fraction trades spread for corner strength at the same count", "[features][orb]") {

@@ -99,6 +99,8 @@ TEST_CASE("system: configuration errors name the key; no depth keeps it uninitia
 TEST_CASE("seq 04 with LiDAR depth: every frame tracked, ATE <= 0.10 m, drift <= 0.8 %") {
   const auto sequence = rgbl::test::kitti_seq04();
   if (!sequence) return;
+  // Frames 30-38 have a van ahead at the car's speed holding many of the strongest corners: without
+  // the tracker's motion prior and coverage ranking this run ends 5.1 m off (docs/tracking.md).
   const auto s = rgbl::test::run_sequence(*sequence, 0, 51);
   INFO("ATE " << s.ate_rmse << " m, drift " << s.drift_percent << " %");
   CHECK(s.frames == 51);

@@ -35,8 +35,10 @@ struct OrbOptions {
   // values trade spread for strength (see docs/features.md).
   int features_per_node = 1;
   // Share of each level's budget placed by the quadtree; the rest goes to the strongest remaining
-  // corners anywhere (1 = all spread, ORB-SLAM; see docs/features.md).
-  double spread_fraction = 1.0;
+  // corners anywhere (1 = all spread, ORB-SLAM). Half and half matches more of the true motion than
+  // either extreme on KITTI (docs/features.md); the tracker's motion prior keeps the strong corners
+  // of an object moving with the camera from taking over the pose (docs/tracking.md).
+  double spread_fraction = 0.5;
   int edge_threshold = 19;      // keypoints keep this many px from every level border
   int patch_size = 31;          // BRIEF patch diameter; sampling points lie within patch_size / 2
   int orientation_radius = 15;  // intensity-centroid disc radius
