@@ -2,7 +2,7 @@
 #include "rgbl/backend/depth_noise.hpp"
 #include "rgbl/backend/pose_optimizer.hpp"
 
-#include "kitti_camera.hpp"
+#include "support/kitti_camera.hpp"
 
 #include <catch2/catch.hpp>
 

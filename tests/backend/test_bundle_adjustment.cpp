@@ -1,6 +1,6 @@
 #include "rgbl/backend/bundle_adjustment.hpp"
 
-#include "kitti_camera.hpp"
+#include "support/kitti_camera.hpp"
 
 #include <catch2/catch.hpp>
 

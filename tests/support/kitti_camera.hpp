@@ -1,5 +1,5 @@
 #pragma once
-// The rectified KITTI seq 04 camera the backend tests project into.
+// The rectified KITTI seq 04 camera (cam0) that synthetic tests project into.
 
 #include "rgbl/geometry/camera.hpp"
 
