@@ -108,7 +108,8 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   bool recent_loss = false;
   if (state_ == TrackState::Ok) {
     if (velocity_ && last_frame_) {
-      motion_inliers = track_with_motion_model(frame, *last_frame_, *velocity_ * last_frame_->T_cam_world);
+      motion_inliers =
+          track_with_motion_model(frame, *last_frame_, *velocity_ * last_frame_->T_cam_world, trusted_velocity());
       ok = motion_ok = motion_inliers >= options_.min_pose_inliers;
     }
     if (!ok) {
@@ -123,7 +124,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
       // Against the last tracked frame (the frames since carry only guesses and maybe no features,
       // e.g. black images), from the guess over the time elapsed.
       const Frame& reference = last_tracked_frame_ ? *last_tracked_frame_ : *last_frame_;
-      motion_inliers = track_with_motion_model(frame, reference, T_predicted);
+      motion_inliers = track_with_motion_model(frame, reference, T_predicted, std::nullopt);
       ok = motion_ok = motion_inliers >= options_.min_pose_inliers;
       if (!ok) clear_matches(frame);
     }
@@ -306,11 +307,10 @@ int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t
   return result.inliers;
 }
 
-int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const Eigen::Isometry3d& T_guess) {
+int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const Eigen::Isometry3d& T_guess,
+                                     const std::optional<Eigen::Isometry3d>& prior) {
   frame.T_cam_world = T_guess;
   if (options_.ransac_prediction) {
-    std::optional<Eigen::Isometry3d> prior;
-    if (options_.ransac_motion_prior && velocity_steady_ && &reference == &*last_frame_) prior = velocity_;
     if (const auto T_cur_last = estimate_frame_motion(camera_, reference, frame, options_, prior)) {
       frame.T_cam_world = *T_cur_last * reference.T_cam_world;
     }
@@ -400,11 +400,9 @@ bool Tracker::track_reference_keyframe(Frame& frame) {
   // initialisation has no velocity yet, and the last pose is then a poor guess at speed).
   frame.T_cam_world = last_frame_ ? last_frame_->T_cam_world : Eigen::Isometry3d::Identity();
   if (last_frame_ && options_.ransac_prediction) {
-    std::optional<Eigen::Isometry3d> prior;
-    if (options_.ransac_motion_prior && velocity_steady_) prior = velocity_;
     TrackerOptions guess_options = options_;  // a guess only: the optimisation below decides
     guess_options.ransac_min_inliers = options_.ransac_guess_min_inliers;
-    if (const auto T_cur_last = estimate_frame_motion(camera_, *last_frame_, frame, guess_options, prior)) {
+    if (const auto T_cur_last = estimate_frame_motion(camera_, *last_frame_, frame, guess_options, trusted_velocity())) {
       frame.T_cam_world = *T_cur_last * last_frame_->T_cam_world;
     }
   }

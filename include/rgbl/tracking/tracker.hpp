@@ -53,8 +53,13 @@ class Tracker {
   bool initialise(Frame& frame, const Eigen::Isometry3d& T_cam_world);
   // Returns the pose inliers (landmarks and temporary points), 0 when matching failed.
   // Guided matching against `reference` (the last frame, or after a loss the last tracked one) from
-  // T_guess, refined by the frame-to-frame motion from depth.
-  int track_with_motion_model(Frame& frame, const Frame& reference, const Eigen::Isometry3d& T_guess);
+  // T_guess, refined by the frame-to-frame motion from depth (constrained to `prior` if given).
+  int track_with_motion_model(Frame& frame, const Frame& reference, const Eigen::Isometry3d& T_guess,
+                              const std::optional<Eigen::Isometry3d>& prior);
+  // The velocity as a motion prior: only while it comes from two consecutive tracked frames.
+  std::optional<Eigen::Isometry3d> trusted_velocity() const {
+    return options_.ransac_motion_prior && velocity_steady_ ? velocity_ : std::nullopt;
+  }
   bool track_reference_keyframe(Frame& frame);
   LocalMapResult track_local_map(Frame& frame);
   // The motion-model hypothesis disagrees with the map or with the recent frames (see TrackerOptions).
