@@ -6,9 +6,11 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <span>
 #include <vector>
 
 namespace rgbl {
@@ -31,8 +33,10 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
   // Consensus is judged by the image area its points cover first, their number second: an object that
   // moves with the camera may hold more matches than the static scene, but the scene spreads wider.
   const double cell_size = options.ransac_coverage_cell;
-  const int cells_x = std::max(1, static_cast<int>(std::ceil(std::max(camera.width, 1) / cell_size)));
+  const bool by_coverage = cell_size > 0.0;
+  const int cells_x = by_coverage ? std::max(1, static_cast<int>(std::ceil(std::max(camera.width, 1) / cell_size))) : 1;
   auto cell_of = [&](const Keypoint& kp) {
+    if (!by_coverage) return 0;  // ranked by size only
     const int cx = std::max(0, static_cast<int>(kp.x / cell_size));
     const int cy = std::max(0, static_cast<int>(kp.y / cell_size));
     return cy * cells_x + std::min(cx, cells_x - 1);
@@ -53,7 +57,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
   const auto matches = detail::match_brute_force(cur_desc, last_desc, options.ransac_max_hamming, options.ransac_ratio);
   const int n = static_cast<int>(matches.size());
   if (n < options.ransac_min_inliers) return std::nullopt;
-  auto fit = [&](const std::vector<int>& idx) {
+  auto fit = [&](std::span<const int> idx) {
     Eigen::Matrix3Xd a(3, static_cast<Eigen::Index>(idx.size())), b(3, static_cast<Eigen::Index>(idx.size()));
     for (std::size_t k = 0; k < idx.size(); ++k) {
       const auto& [q, t] = matches[static_cast<std::size_t>(idx[k])];
@@ -82,12 +86,12 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
   };
   std::vector<int> cell_marks;
   auto score_of = [&](const std::vector<int>& consensus) {
+    if (!by_coverage) return std::pair<long, std::size_t>(0L, consensus.size());
     cell_marks.clear();
     for (const int m : consensus) cell_marks.push_back(cur_cell[static_cast<std::size_t>(matches[static_cast<std::size_t>(m)].first)]);
     std::sort(cell_marks.begin(), cell_marks.end());
     const auto cells = std::unique(cell_marks.begin(), cell_marks.end()) - cell_marks.begin();
-    return std::pair<long, std::size_t>(options.ransac_coverage_cell > 0.0 ? static_cast<long>(cells) : 0L,
-                                        consensus.size());
+    return std::pair<long, std::size_t>(static_cast<long>(cells), consensus.size());
   };
   const bool use_prior = prior.has_value();
   auto near_prior = [&](const Eigen::Isometry3d& T) {
@@ -112,7 +116,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     near_score = score_of(best_near);
   }
   for (int it = 0; it < options.ransac_iterations; ++it) {
-    std::vector<int> sample = {pick(rng), pick(rng), pick(rng)};
+    const std::array<int, 3> sample = {pick(rng), pick(rng), pick(rng)};
     if (sample[0] == sample[1] || sample[1] == sample[2] || sample[0] == sample[2]) continue;
     const Eigen::Isometry3d T = fit(sample);
     inliers_of(T, current);

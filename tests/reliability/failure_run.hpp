@@ -79,6 +79,19 @@ inline std::vector<Step> frames(std::size_t first, std::size_t last) {
   return steps;
 }
 
+// Frames first..last, then a jump to to_first..to_last (forwards or back). renumber: the fed indices,
+// hence the timestamps, run on without a gap (0, 1, 2, ...): only the images jump.
+inline std::vector<Step> jump(std::size_t first, std::size_t last, std::size_t to_first, std::size_t to_last,
+                              bool renumber = false) {
+  auto steps = frames(first, last);
+  const auto after = frames(to_first, to_last);
+  steps.insert(steps.end(), after.begin(), after.end());
+  if (renumber) {
+    for (std::size_t i = 0; i < steps.size(); ++i) steps[i].index = i;
+  }
+  return steps;
+}
+
 // Every fed frame is in the trajectory, in order, with the state track() reported and a finite pose.
 inline void check_complete(const Outcome& o) {
   REQUIRE(o.trajectory.size() == o.results.size());

@@ -36,10 +36,7 @@ TEST_CASE("threaded mapping: black frames and a dropped scan, every frame record
 TEST_CASE("threaded mapping: a jump of 20 frames starts a new map while mapping runs") {
   const auto sequence = rgbl::test::kitti_seq04();
   if (!sequence) return;
-  auto steps = rgbl::test::frames(0, 14);
-  const auto after = rgbl::test::frames(35, 44);
-  steps.insert(steps.end(), after.begin(), after.end());
-  const auto o = rgbl::test::run(*sequence, steps, true);
+  const auto o = rgbl::test::run(*sequence, rgbl::test::jump(0, 14, 35, 44), true);
   INFO(rgbl::test::states(o));
   rgbl::test::check_complete(o);
   CHECK(o.results[15].state == rgbl::TrackState::Lost);

@@ -8,6 +8,7 @@
 
 using rgbl::test::check_complete;
 using rgbl::test::frames;
+using rgbl::test::jump;
 using rgbl::test::relative_error;
 using rgbl::test::run;
 using rgbl::test::states;
@@ -58,10 +59,7 @@ TEST_CASE("a dropped scan (empty) is a frame without depth: tracking continues o
 TEST_CASE("a sudden jump of 20 frames: detected, lost, a new map started and recorded, motion after it right") {
   const auto sequence = rgbl::test::kitti_seq04();
   if (!sequence) return;
-  auto steps = frames(0, 14);
-  const auto after = frames(35, 50);
-  steps.insert(steps.end(), after.begin(), after.end());
-  const Outcome o = run(*sequence, steps);
+  const Outcome o = run(*sequence, jump(0, 14, 35, 50));
   INFO(states(o) << " error at 35: " << relative_error(o, 15) << " m");
   check_complete(o);
   for (std::size_t i = 0; i < 15; ++i) CHECK(o.results[i].state == rgbl::TrackState::Ok);
@@ -90,11 +88,7 @@ TEST_CASE("a sudden jump of 20 frames: detected, lost, a new map started and rec
 TEST_CASE("a jump in the images with no gap in the clock: detected from the images alone") {
   const auto sequence = rgbl::test::kitti_seq04();
   if (!sequence) return;
-  auto steps = frames(0, 14);
-  const auto after = frames(35, 50);
-  steps.insert(steps.end(), after.begin(), after.end());
-  for (std::size_t i = 0; i < steps.size(); ++i) steps[i].index = i;  // frame 35 arrives as index 15
-  const Outcome o = run(*sequence, steps);
+  const Outcome o = run(*sequence, jump(0, 14, 35, 50, true));  // frame 35 arrives as index 15
   INFO(states(o));
   check_complete(o);
   for (std::size_t i = 0; i < 15; ++i) CHECK(o.results[i].state == rgbl::TrackState::Ok);
@@ -124,11 +118,7 @@ TEST_CASE("a jump in the images with no gap in the clock: detected from the imag
 TEST_CASE("a jump back into the mapped stretch: relocalised in the map at once") {
   const auto sequence = rgbl::test::kitti_seq04();
   if (!sequence) return;
-  auto steps = frames(0, 30);
-  const auto back = frames(10, 20);
-  steps.insert(steps.end(), back.begin(), back.end());
-  for (std::size_t i = 0; i < steps.size(); ++i) steps[i].index = i;  // no gap in the clock either
-  const Outcome o = run(*sequence, steps);
+  const Outcome o = run(*sequence, jump(0, 30, 10, 20, true));  // no gap in the clock either
   INFO(states(o));
   check_complete(o);
   // Frame 10 after frame 30: the motion model cannot explain it; relocalisation against the whole map
