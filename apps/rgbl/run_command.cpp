@@ -78,8 +78,8 @@ KittiMetricOptions kitti_lengths_for(double path_length, std::string& descriptio
 // Outputs of an earlier run in the same folder would look like this run's if it fails: remove them
 // before anything can fail (a successful run overwrites them anyway).
 void remove_previous_outputs(const std::filesystem::path& out_dir) {
-  for (const char* name : {"trajectory_kitti.txt", "trajectory_tum.txt", "timing.csv", "summary.json",
-                           "trajectory.svg", "map.ply"}) {
+  for (const char* name : {"trajectory_kitti.txt", "trajectory_tum.txt", "ground_truth_kitti.txt",
+                           "timing.csv", "summary.json", "trajectory.svg", "map.ply"}) {
     std::error_code ec;
     std::filesystem::remove(out_dir / name, ec);
   }
@@ -181,6 +181,9 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
       est_poses.push_back(estimate.poses[i]);
       gt_poses.push_back(gt->poses[p.first + i * p.step]);
     }
+    // the ground truth of the frames run, row for row with trajectory_kitti.txt (for evo and plots;
+    // a raw drive's comes from OXTS and has no file of its own)
+    write_kitti_trajectory(out_dir / "ground_truth_kitti.txt", gt_poses);
   }
   std::string metrics_json = "null";
   if (gt_poses.size() >= 2) {
