@@ -11,7 +11,8 @@
 namespace rgbl::cli {
 
 struct RunOutcome {
-  std::size_t frames = 0, tracked = 0, lost = 0, not_initialised = 0, keyframes = 0, landmarks = 0;
+  std::size_t frames = 0, tracked = 0, weak = 0, lost = 0, not_initialised = 0, keyframes = 0, landmarks = 0;
+  std::optional<int> min_inliers_ok;  // fewest local-map inliers on a frame reported ok
   double wall_s = 0.0;
   double median_front_ms = 0.0;  // depth + extraction + tracking
   double median_total_ms = 0.0, mean_total_ms = 0.0;

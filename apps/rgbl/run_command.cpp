@@ -139,6 +139,10 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
   out.frames = records.size();
   for (const auto& r : records) {
     out.tracked += r.result.state == TrackState::Ok ? 1 : 0;
+    out.weak += r.result.state == TrackState::Weak ? 1 : 0;
+    if (r.result.state == TrackState::Ok) {
+      out.min_inliers_ok = std::min(out.min_inliers_ok.value_or(r.result.inliers), r.result.inliers);
+    }
     out.lost += r.result.state == TrackState::Lost ? 1 : 0;
     out.not_initialised += r.result.state == TrackState::NotInitialised ? 1 : 0;
     out.keyframes += r.result.keyframe ? 1 : 0;
@@ -216,7 +220,7 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
     }
     PlotSeries e{fmt::format("rgbl ({})", p.depth_name), "#d62728", {}, false};
     for (std::size_t i = 0; i < estimate.poses.size(); ++i) {
-      const bool ok = i < records.size() && records[i].result.state == TrackState::Ok;
+      const bool ok = i < records.size() && has_pose(records[i].result.state);
       e.positions.push_back(ok ? Eigen::Vector3d(estimate.poses[i].translation())
                                : Eigen::Vector3d::Constant(std::nan("")));
     }
@@ -266,17 +270,20 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
     return fmt::format("\"{}\": {{\"median\": {}, \"p95\": {}, \"mean\": {}, \"max\": {}}}", name,
                        json_number(s.median), json_number(s.p95), json_number(s.mean), json_number(s.max));
   };
-  std::string lost_frames;
-  for (const auto& r : records) {
-    if (r.result.state != TrackState::Lost) continue;
-    lost_frames += (lost_frames.empty() ? "" : ", ") + std::to_string(r.result.frame_index);
-  }
+  const auto frame_list = [&records](auto&& selected) {
+    std::string list;
+    for (const auto& r : records) {
+      if (selected(r.result)) list += (list.empty() ? "" : ", ") + std::to_string(r.result.frame_index);
+    }
+    return list;
+  };
+  const std::string lost_frames = frame_list([](const TrackResult& r) { return r.state == TrackState::Lost; });
+  const std::string weak_frames = frame_list([](const TrackResult& r) { return r.state == TrackState::Weak; });
   // Frames where tracking, lost beyond relocalisation, started a new map anchored at a guessed pose.
-  std::string new_map_frames;
-  for (const auto& r : records) {
-    if (!r.result.new_map) continue;
-    new_map_frames += (new_map_frames.empty() ? "" : ", ") + std::to_string(r.result.frame_index);
-  }
+  const std::string new_map_frames = frame_list([](const TrackResult& r) { return r.new_map; });
+  // Steps beyond a vehicle's reach: taken on strong evidence, or rejected (the frame placed at the prediction).
+  const std::string jump_frames = frame_list([](const TrackResult& r) { return r.jump; });
+  const std::string rejected_frames = frame_list([](const TrackResult& r) { return r.step_rejected; });
   {
     const auto file = out_dir / "summary.json";
     std::ofstream json(file);
@@ -285,11 +292,14 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
                         json_string(p.sequence->path().string()), json_string(std::string(to_string(p.sequence->format()))),
                         p.camera, json_string(p.depth_name))
          << fmt::format("  \"first_frame\": {},\n  \"step\": {},\n", p.first, p.step)
-         << fmt::format("  \"frames\": {},\n  \"tracked\": {},\n  \"lost\": {},\n  \"not_initialised\": {},\n"
-                        "  \"lost_frames\": [{}],\n  \"new_map_frames\": [{}],\n  \"keyframes\": {},\n"
-                        "  \"landmarks\": {},\n",
-                        out.frames, out.tracked, out.lost, out.not_initialised, lost_frames, new_map_frames,
-                        out.keyframes, out.landmarks)
+         << fmt::format("  \"frames\": {},\n  \"tracked\": {},\n  \"weak\": {},\n  \"lost\": {},\n"
+                        "  \"not_initialised\": {},\n  \"weak_frames\": [{}],\n  \"lost_frames\": [{}],\n"
+                        "  \"new_map_frames\": [{}],\n  \"jump_frames\": [{}],\n  \"rejected_step_frames\": [{}],\n"
+                        "  \"min_inliers_ok\": {},\n  \"keyframes\": {},\n  \"landmarks\": {},\n",
+                        out.frames, out.tracked, out.weak, out.lost, out.not_initialised, weak_frames, lost_frames,
+                        new_map_frames, jump_frames, rejected_frames,
+                        out.min_inliers_ok ? std::to_string(*out.min_inliers_ok) : "null", out.keyframes,
+                        out.landmarks)
          << fmt::format("  \"threaded_mapping\": {},\n  \"wall_s\": {},\n", threaded ? "true" : "false",
                         json_number(out.wall_s))
          << "  \"stage_ms\": {\n    " << stage_json("io_wait", stats(io_ms)) << ",\n    "
@@ -303,8 +313,9 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
 
   fmt::print("\n{} ({}), camera {}, depth {}: {} frames in {:.1f} s\n", p.sequence->name(),
              to_string(p.sequence->format()), p.camera, p.depth_name, out.frames, out.wall_s);
-  fmt::print("  tracked {}, lost {}, not initialised {}; {} keyframes, {} landmarks\n", out.tracked, out.lost,
-             out.not_initialised, out.keyframes, out.landmarks);
+  fmt::print("  ok {}, weak {}, lost {}, not initialised {}; {} keyframes, {} landmarks\n", out.tracked,
+             out.weak, out.lost, out.not_initialised, out.keyframes, out.landmarks);
+  if (!jump_frames.empty()) fmt::print("  steps beyond a vehicle's reach taken at frame(s) {}\n", jump_frames);
   if (!new_map_frames.empty()) fmt::print("  lost beyond relocalisation: new map started at frame(s) {}\n", new_map_frames);
   fmt::print("  per frame (median / p95 ms): depth {:.2f} / {:.2f}, extraction {:.2f} / {:.2f}, tracking {:.2f} / "
              "{:.2f}, mapping {:.2f} / {:.2f}\n",

@@ -33,6 +33,16 @@ void TrackerOptions::validate() const {
   require(ransac_prior_relative >= 0.0, "tracker.ransac_prior_relative", ">= 0");
   require(ransac_prior_rotation_deg >= 0.0 && ransac_prior_rotation_deg <= 180.0, "tracker.ransac_prior_rotation_deg",
           "in [0, 180] degrees");
+  require(min_ok_inliers >= min_pose_inliers, "tracker.min_ok_inliers", ">= tracker.min_pose_inliers");
+  require(min_ok_inliers_after_relocalisation >= min_ok_inliers, "tracker.min_ok_inliers_after_relocalisation",
+          ">= tracker.min_ok_inliers");
+  require(relocalisation_window >= 0, "tracker.relocalisation_window", ">= 0 frames");
+  require(step_tolerance >= 0.0, "tracker.step_tolerance", ">= 0 m");
+  require(step_tolerance_relative >= 0.0, "tracker.step_tolerance_relative", ">= 0");
+  require(max_acceleration >= 0.0, "tracker.max_acceleration", ">= 0 m/s^2");
+  require(step_tolerance_rotation_deg >= 0.0 && step_tolerance_rotation_deg <= 180.0,
+          "tracker.step_tolerance_rotation_deg", "in [0, 180] degrees");
+  require(min_jump_inliers >= min_pose_inliers, "tracker.min_jump_inliers", ">= tracker.min_pose_inliers");
   require(max_frames_between_keyframes >= 1, "tracker.max_frames_between_keyframes", ">= 1");
   require(close_depth > 0.0, "tracker.close_depth", "> 0");
   pose.validate();

@@ -167,7 +167,7 @@ TrackResult System::track(const SensorFrame& sensor) {
     frame.depth_sigma[i] = static_cast<float>(sigma);
     with_depth += sigma > 0.0 ? 1 : 0;
   }
-  if (s.options.lidar_scan_period > 0.0 && s.tracker.state() == TrackState::Ok && s.tracker.velocity()) {
+  if (s.options.lidar_scan_period > 0.0 && has_pose(s.tracker.state()) && s.tracker.velocity()) {
     compensate_lidar_motion(s, frame);
   }
   frame.build_grid(s.calibration.camera.width, s.calibration.camera.height);
@@ -195,6 +195,8 @@ TrackResult System::track(const SensorFrame& sensor) {
   result.keyframe = outcome.initialised_now || new_keyframe.valid();
   result.relocalised = outcome.relocalised;
   result.new_map = outcome.new_map;
+  result.jump = outcome.jump;
+  result.step_rejected = outcome.step_rejected;
   result.inliers = outcome.inliers;
   result.keypoints = static_cast<int>(n);
   result.keypoints_with_depth = with_depth;

@@ -32,15 +32,6 @@ Keyframe keyframe_from(const Frame& frame) {
 
 }  // namespace
 
-const char* to_string(TrackState state) {
-  switch (state) {
-    case TrackState::NotInitialised: return "not_initialised";
-    case TrackState::Ok: return "ok";
-    case TrackState::Lost: return "lost";
-  }
-  return "unknown";
-}
-
 Tracker::Tracker(Map& map, const PinholeCamera& camera, TrackerOptions options)
     : map_(map), camera_(camera), options_(options) {
   options_.validate();
@@ -106,7 +97,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   bool motion_ok = false;
   int motion_inliers = 0;
   bool recent_loss = false;
-  if (state_ == TrackState::Ok) {
+  if (has_pose(state_)) {
     if (velocity_ && last_frame_) {
       motion_inliers =
           track_with_motion_model(frame, *last_frame_, *velocity_ * last_frame_->T_cam_world, trusted_velocity());
@@ -191,17 +182,52 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
                       outcome.relocalised ? "relocalised" : (ok ? "confirmed" : "lost"));
     }
   }
+  if (ok && options_.check_steps && velocity_steady_ && has_pose(state_) && last_frame_ && !outcome.relocalised) {
+    // Never take silently a step that a vehicle cannot make: only on the evidence a relocalisation
+    // needs (then reported), else try the local map from the prediction, else keep the prediction.
+    const double dt = frame.timestamp - last_frame_->timestamp;
+    const double predicted_step = (T_predicted.inverse().translation() - T_last.inverse().translation()).norm();
+    const StepCheck step = check_step(frame.T_cam_world, T_predicted, predicted_step, dt, options_);
+    if (!step.plausible && inliers >= options_.min_jump_inliers && !weak) {
+      outcome.jump = true;
+      logger()->warn("frame {}: step {:.2f} m / {:.1f} deg off the constant-velocity prediction (allowed {:.2f} m), "
+                     "taken on {} inliers", frame.index, step.translation_m, step.rotation_deg,
+                     step.allowed_translation_m, inliers);
+    } else if (!step.plausible) {
+      Frame candidate = frame;
+      candidate.T_cam_world = T_predicted;
+      clear_matches(candidate);
+      const LocalMapResult from_prediction = track_local_map(candidate);
+      const StepCheck candidate_step = check_step(candidate.T_cam_world, T_predicted, predicted_step, dt, options_);
+      logger()->debug("frame {}: step {:.2f} m / {:.1f} deg off the prediction (allowed {:.2f} m) on {} inliers; "
+                      "from the prediction the local map finds {} ({:.2f} m off)", frame.index, step.translation_m,
+                      step.rotation_deg, step.allowed_translation_m, inliers, from_prediction.inliers,
+                      candidate_step.translation_m);
+      if (from_prediction.ok && candidate_step.plausible) {
+        frame = std::move(candidate);
+        inliers = count_tracked(frame);
+        weak = false;
+      } else {
+        frame.T_cam_world = T_predicted;
+        clear_matches(frame);
+        inliers = 0;
+        weak = true;
+        outcome.step_rejected = true;
+      }
+    }
+  }
   if (ok) {
-    const bool consecutive = state_ == TrackState::Ok;  // the previous frame was tracked too
-    state_ = TrackState::Ok;
+    const bool consecutive = has_pose(state_);  // the previous frame was tracked too
+    state_ = weak ? TrackState::Weak : support_state(inliers, frames_since_relocalisation(frame), options_);
     last_ok_frame_ = frame.index;
     last_inliers_ = inliers;
-    if (last_frame_) {
+    if (last_frame_ && !outcome.step_rejected) {
       velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
       velocity_dt_ = frame.timestamp - last_frame_->timestamp;
       velocity_steady_ = consecutive && motion_ok && !outcome.relocalised;
     }
-    outcome.need_keyframe = weak || need_keyframe(frame, inliers, mapping_idle);
+    // a frame placed at the prediction has no observations worth a keyframe
+    outcome.need_keyframe = !outcome.step_rejected && (weak || need_keyframe(frame, inliers, mapping_idle));
   } else {
     const bool was_lost = state_ == TrackState::Lost;
     state_ = TrackState::Lost;
@@ -221,9 +247,9 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   }
   outcome.state = state_;
   outcome.inliers = inliers;
-  if (state_ == TrackState::Ok) {
+  if (has_pose(state_)) {
     last_tracked_frame_.reset();
-  } else if (previous_state == TrackState::Ok && last_frame_) {
+  } else if (has_pose(previous_state) && last_frame_) {
     last_tracked_frame_ = std::move(last_frame_);  // the first lost frame: keep the last tracked one
   }
   last_frame_ = frame;
@@ -503,13 +529,10 @@ Tracker::LocalMapResult Tracker::track_local_map(Frame& frame) {
     }
   }
   discard_outliers(frame);
-  const bool recently_relocalised =
-      last_relocalisation_frame_ > 0 && frame.index < last_relocalisation_frame_ + 
-      static_cast<std::size_t>(options_.max_frames_between_keyframes);
   LocalMapResult result;
   result.inliers = inliers;
   result.visible = static_cast<int>(visible.size());
-  result.ok = inliers >= (recently_relocalised ? options_.relocalisation_min_inliers : options_.min_local_map_inliers);
+  result.ok = support_state(inliers, frames_since_relocalisation(frame), options_) == TrackState::Ok;
   return result;
 }
 
@@ -528,7 +551,7 @@ bool Tracker::relocalise(Frame& frame) {
   }
   const auto matches = detail::match_brute_force(frame.descriptors, train, options_.max_hamming, 0.75);
   // A hypothesis needs only a few matches: the map-wide ratio test keeps few of them. It is accepted
-  // only when the local-map search from its pose then finds relocalisation_min_inliers (as ORB-SLAM).
+  // only when the local-map search from its pose then finds min_ok_inliers_after_relocalisation (as ORB-SLAM).
   if (static_cast<int>(matches.size()) < options_.relocalisation_min_matches) return false;
   std::vector<cv::Point3f> object;
   std::vector<cv::Point2f> image;

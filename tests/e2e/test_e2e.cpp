@@ -231,7 +231,14 @@ void check_survived(const SimData& data, const RunResult& run, int first_bad, in
   // tracking before the trouble
   for (int i = 0; i < first_bad; ++i) CHECK(run.results[static_cast<std::size_t>(i)].state == rgbl::TrackState::Ok);
   std::string states;
-  for (const auto& r : run.results) states += r.state == rgbl::TrackState::Ok ? 'o' : (r.state == rgbl::TrackState::Lost ? 'L' : 'n');
+  for (const auto& r : run.results) {
+    switch (r.state) {
+      case rgbl::TrackState::Ok: states += 'o'; break;
+      case rgbl::TrackState::Weak: states += 'w'; break;
+      case rgbl::TrackState::Lost: states += 'L'; break;
+      case rgbl::TrackState::NotInitialised: states += 'n'; break;
+    }
+  }
   fmt::print("e2e states {} (trouble in frames {}..{})\n", states, first_bad, last_bad);
 
 }
@@ -251,9 +258,22 @@ TEST_CASE("an untextured stretch is survived", "[e2e]") {
   report("untextured 15..22", run, data.frames.size());
   check_survived(data, run, 15, 22);
   // Plain surfaces still have corners (object outlines, shading of faces, markings' edges): ORB finds
-  // ~1100 instead of ~1950 keypoints there and tracking holds (measured: 40/40, ATE 0.06 m).
+  // ~1100 instead of ~1950 keypoints there and tracking holds (measured: 40/40 with a pose, ATE
+  // 0.06 m); the first plain frame finds too few local-map points (the map holds textured corners) and
+  // is honestly weak, every other frame ok.
   for (int i = 15; i <= 22; ++i) CHECK(run.results[static_cast<std::size_t>(i)].keypoints < 1500);
-  CHECK(run.tracked == data.frames.size());
+  std::size_t weak = 0;
+  for (std::size_t i = 0; i < run.results.size(); ++i) {
+    const auto state = run.results[i].state;
+    CHECK(rgbl::has_pose(state));
+    if (state == rgbl::TrackState::Weak) {
+      ++weak;
+      CHECK(i >= 15);  // only from the trouble on
+      CHECK(i <= 23);
+    }
+  }
+  CHECK(weak <= 2);
+  CHECK(run.tracked + weak == data.frames.size());
   CHECK(run.ate < 0.15);
 }
 

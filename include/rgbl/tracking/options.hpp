@@ -23,14 +23,13 @@ struct TrackerOptions {
   double min_view_cos = 0.5;            // viewing-angle test
   int max_local_keyframes = 80;
   int min_pose_inliers = 10;            // pose optimisation success
-  int min_local_map_inliers = 30;       // local-map tracking success
   int relocalisation_min_matches = 15;  // map-wide descriptor matches to try a relocalisation (PnP RANSAC)
-  int relocalisation_min_inliers = 50;  // local-map inliers to accept it
   // ...and the share of the local-map points predicted visible that the search re-finds (judged where
   // that means at least min_pose_inliers points). On KITTI 04's repetitive road wrong relocalisations
   // (7.9 and 29 m off) re-found 9.3-9.4 %, right ones >= 16.6 %.
   double relocalisation_min_found_ratio = 0.12;
-  bool keep_weak_tracking = true;       // local map fails but the motion model held: keep going, add a keyframe
+  // local map fails but the motion model held: keep going as a `weak` frame (and add a keyframe)
+  bool keep_weak_tracking = true;
   std::size_t recent_loss_frames = 5;   // after a loss, try the motion model this long before relocalising
   // Verification of the motion-model hypothesis (a jump in the input lands on a repetitive road that
   // the map "explains" from a pose tens of metres off). It is suspect when the local-map search re-finds
@@ -75,6 +74,25 @@ struct TrackerOptions {
   double ransac_prior_translation = 0.3;   // m
   double ransac_prior_relative = 0.25;
   double ransac_prior_rotation_deg = 3.0;
+  // Honest states (rgbl/tracking/support.hpp): a tracked frame is `ok` with at least min_ok_inliers
+  // local-map inliers, min_ok_inliers_after_relocalisation for relocalisation_window frames after a
+  // relocalisation (ORB-SLAM's 30 and 50 within a second; a relocalisation itself needs the latter),
+  // else `weak`.
+  int min_ok_inliers = 30;
+  int min_ok_inliers_after_relocalisation = 50;
+  int relocalisation_window = 10;          // frames
+  // Step plausibility: while the velocity comes from two consecutive tracked frames, a pose may differ
+  // from the constant-velocity prediction by step_tolerance + step_tolerance_relative * |predicted step|
+  // + max_acceleration * dt^2 / 2 (two pose estimates' noise, the velocity's own error, and a change of
+  // speed within a car's reach) and step_tolerance_rotation_deg. A larger step is taken only with
+  // min_jump_inliers (what a relocalisation needs) and is then reported as a jump; otherwise the frame
+  // is weak and placed at the prediction.
+  bool check_steps = true;
+  double step_tolerance = 0.25;            // m
+  double step_tolerance_relative = 0.1;
+  double max_acceleration = 10.0;          // m/s^2, 1 g: more than a car brakes
+  double step_tolerance_rotation_deg = 3.0;
+  int min_jump_inliers = 50;
   bool temporary_points = true;         // last-frame depth points without landmark join the motion model
   // Keyframe decision (SPEC section 5)
   int max_frames_between_keyframes = 10;

@@ -55,7 +55,9 @@ struct TrackResult {
   bool keyframe = false;
   bool relocalised = false;  // placed by relocalisation against the whole map
   bool new_map = false;      // tracking was lost and a new map started here (poses anchored at a guess)
-  int inliers = 0;
+  bool jump = false;         // a step beyond a vehicle's reach, taken on strong evidence
+  bool step_rejected = false;  // a step beyond a vehicle's reach on weak evidence: weak, at the prediction
+  int inliers = 0;           // local-map inliers (ok needs 30, 50 after a relocalisation)
   int keypoints = 0, keypoints_with_depth = 0;
   StageTiming timing;
 };

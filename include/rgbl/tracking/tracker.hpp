@@ -9,14 +9,11 @@
 #include "rgbl/map/map.hpp"
 #include "rgbl/tracking/frame.hpp"
 #include "rgbl/tracking/options.hpp"
+#include "rgbl/tracking/support.hpp"
 
 #include <optional>
 
 namespace rgbl {
-
-enum class TrackState { NotInitialised, Ok, Lost };
-
-const char* to_string(TrackState state);
 
 struct TrackerOutcome {
   TrackState state = TrackState::NotInitialised;
@@ -25,6 +22,9 @@ struct TrackerOutcome {
   bool new_map = false;         // lost, relocalisation failed: a new map was started at this frame
   bool need_keyframe = false;
   int inliers = 0;
+  // The pose's step from the previous frame exceeded what a vehicle can do (see check_step):
+  bool jump = false;           // ...taken on strong evidence (min_jump_inliers) and reported
+  bool step_rejected = false;  // ...on weak evidence: the frame is weak, placed at the prediction
 };
 
 class Tracker {
@@ -70,6 +70,10 @@ class Tracker {
   // extra: (keypoint, world point) correspondences that are not landmarks (temporary points).
   int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {});
   bool need_keyframe(const Frame& frame, int inliers, bool mapping_idle) const;
+  std::optional<std::size_t> frames_since_relocalisation(const Frame& frame) const {
+    if (last_relocalisation_frame_ == 0 || frame.index < last_relocalisation_frame_) return std::nullopt;
+    return frame.index - last_relocalisation_frame_;
+  }
   void update_local_map(const Frame& frame);
 
   Map& map_;

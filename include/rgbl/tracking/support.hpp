@@ -1,0 +1,47 @@
+#pragma once
+// The rule that says how far a tracked frame's pose can be trusted, as pure functions so that it is
+// stated once and unit-tested on its own.
+//
+// A frame is `ok` only with enough support: ORB-SLAM's thresholds, min_ok_inliers (30) map-point
+// inliers, and min_ok_inliers_after_relocalisation (50) for relocalisation_window frames after a
+// relocalisation, when the pose has no motion history to back it. A frame with a pose but less
+// support is `weak`. Independently, a step is plausible only if it stays within what a vehicle can do
+// between two frames (StepBounds); an implausible step is taken only on the evidence a relocalisation
+// needs, and then reported as a jump, never silently.
+
+#include "rgbl/tracking/options.hpp"
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <optional>
+
+namespace rgbl {
+
+enum class TrackState { NotInitialised, Ok, Weak, Lost };
+
+const char* to_string(TrackState state);
+
+// A pose was estimated for the frame (ok or weak).
+constexpr bool has_pose(TrackState state) { return state == TrackState::Ok || state == TrackState::Weak; }
+
+// `ok` or `weak` for a frame tracked with `inliers` map-point inliers; frames_since_relocalisation is
+// empty when there was none (0 = this frame was relocalised).
+TrackState support_state(int inliers, std::optional<std::size_t> frames_since_relocalisation,
+                         const TrackerOptions& options);
+
+// How far a pose is from the constant-velocity prediction, and whether that is within a vehicle's
+// reach in dt seconds.
+struct StepCheck {
+  double translation_m = 0.0;    // distance between the two camera centres
+  double rotation_deg = 0.0;     // angle of the relative rotation
+  double allowed_translation_m = 0.0;
+  bool plausible = true;
+};
+
+// T_cam_world poses; predicted_step_m is the length of the predicted step (its relative tolerance),
+// dt the time since the previous frame (its acceleration tolerance; <= 0: unknown, not counted).
+StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry3d& T_cam_world_predicted,
+                     double predicted_step_m, double dt, const TrackerOptions& options);
+
+}  // namespace rgbl

@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# The accuracy suite (docs/accuracy.md): every real KITTI excerpt found in the data folder and every
+# simulator scenario with several seeds, tracked with default settings; one table (ATE, drift, RPE,
+# fewest inliers on an ok frame, weak and lost frames, keyframes per 100 frames, median ms) and the
+# difference to a saved baseline. Judge every tracking change on the whole table.
+#
+#   scripts/accuracy.sh [--build DIR] [--out DIR] [--seeds "1 2 3"] [--frames N] [--scenarios "a b"]
+#                       [--baseline FILE] [--save-baseline FILE] [--no-real] [--no-sim] [-- ARGS for rgbl run]
+#
+# Data: $RGBL_DATA, else ../shared/data next to the repository. Generated scenarios are cached in
+# $RGBL_CACHE (default ~/.cache/rgbl/scenarios), keyed by the simulator's sources, so a rerun after a
+# tracker change only tracks.
+set -euo pipefail
+
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="$repo/build/release"
+out="$repo/build/accuracy"
+seeds="1 2 3"
+frames=80
+scenarios=""
+baseline="$repo/docs/accuracy-baseline.json"
+save=""
+real=1
+sim=1
+extra=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build) build="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    --seeds) seeds="$2"; shift 2 ;;
+    --frames) frames="$2"; shift 2 ;;
+    --scenarios) scenarios="$2"; shift 2 ;;
+    --baseline) baseline="$2"; shift 2 ;;
+    --save-baseline) save="$2"; shift 2 ;;
+    --no-real) real=0; shift ;;
+    --no-sim) sim=0; shift ;;
+    --) shift; extra=("$@"); break ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    *) echo "accuracy.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+
+rgbl="$build/bin/rgbl"
+table="$build/bin/rgbl_accuracy_table"
+for b in "$rgbl" "$table"; do
+  [ -x "$b" ] || { echo "accuracy.sh: $b not built (cmake --preset release && cmake --build build/release)" >&2; exit 1; }
+done
+data="${RGBL_DATA:-$repo/../shared/data}"
+cache="${RGBL_CACHE:-$HOME/.cache/rgbl/scenarios}"
+rm -rf "$out"
+mkdir -p "$out/runs" "$cache"
+log="$out/log.txt"
+: > "$log"
+
+track() {  # name, then rgbl arguments
+  local name="$1"; shift
+  echo "== $name: rgbl $*" >> "$log"
+  if "$rgbl" -q "$@" --out "$out/runs/$name" >> "$log" 2>&1; then
+    printf '  %-28s %s\n' "$name" "$(grep -h -o 'ATE RMSE [0-9.]* m' "$log" | tail -1)"
+  else
+    printf '  %-28s FAILED (see %s)\n' "$name" "$log"
+  fi
+}
+
+if [ "$real" = 1 ]; then
+  if [ -d "$data/kitti" ]; then
+    echo "real excerpts in $data/kitti:"
+    for seq in "$data"/kitti/odometry/sequences/*/; do
+      [ -d "$seq" ] && track "real-odometry-$(basename "$seq")" run "$seq" "${extra[@]}"
+    done
+    for drive in "$data"/kitti/raw*/*/*_sync/; do
+      [ -d "$drive" ] || continue
+      set_name="$(basename "$(dirname "$(dirname "$drive")")")"   # raw or raw_extended
+      id="$(basename "$drive" | sed -E 's/.*_drive_([0-9]+)_sync/\1/')"
+      track "real-$set_name-$id" run "$drive" "${extra[@]}"
+    done
+  else
+    echo "skipped: no data ($data/kitti absent; set RGBL_DATA)"
+  fi
+fi
+
+if [ "$sim" = 1 ]; then
+  [ -n "$scenarios" ] || scenarios="$("$rgbl" demo --scenario list | awk 'NF && $1 !~ /:$/ {print $1}')"
+  key="$(cat "$repo"/src/sim/* "$repo"/include/rgbl/sim/* "$repo"/apps/rgbl/demo_command.cpp | sha1sum | cut -c1-12)"
+  echo "scenarios ($frames frames, seeds $seeds; cache $cache, key $key):"
+  for s in $scenarios; do
+    for seed in $seeds; do
+      dir="$cache/$s-s$seed-f$frames-$key"
+      if [ ! -f "$dir/.complete" ]; then
+        rm -rf "$dir"
+        echo "== generate $s seed $seed" >> "$log"
+        "$rgbl" -q demo --scenario "$s" --seed "$seed" --frames "$frames" --keep "$dir" --out "$out/gen-$s-$seed" \
+          >> "$log" 2>&1 && touch "$dir/.complete" || { printf '  %-28s generation FAILED\n' "$s-s$seed"; continue; }
+        rm -rf "$out/gen-$s-$seed"
+      fi
+      track "$s-s$seed" run "$dir/sequences/00" "${extra[@]}"
+    done
+  done
+fi
+
+echo
+table_args=("$out/runs")
+[ -f "$baseline" ] && table_args+=(--baseline "$baseline")
+[ -n "$save" ] && table_args+=(--save-baseline "$save")
+"$table" "${table_args[@]}" | tee "$out/table.md"
+echo
+echo "table in $out/table.md, logs in $log"

@@ -1,0 +1,43 @@
+#include "rgbl/tracking/support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace rgbl {
+
+const char* to_string(TrackState state) {
+  switch (state) {
+    case TrackState::NotInitialised: return "not_initialised";
+    case TrackState::Ok: return "ok";
+    case TrackState::Weak: return "weak";
+    case TrackState::Lost: return "lost";
+  }
+  return "unknown";
+}
+
+TrackState support_state(int inliers, std::optional<std::size_t> frames_since_relocalisation,
+                         const TrackerOptions& options) {
+  const bool after_relocalisation =
+      frames_since_relocalisation && *frames_since_relocalisation < static_cast<std::size_t>(options.relocalisation_window);
+  const int needed = after_relocalisation ? options.min_ok_inliers_after_relocalisation : options.min_ok_inliers;
+  return inliers >= needed ? TrackState::Ok : TrackState::Weak;
+}
+
+StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry3d& T_cam_world_predicted,
+                     double predicted_step_m, double dt, const TrackerOptions& options) {
+  StepCheck check;
+  const Eigen::Vector3d centre = T_cam_world.inverse().translation();
+  const Eigen::Vector3d predicted_centre = T_cam_world_predicted.inverse().translation();
+  check.translation_m = (centre - predicted_centre).norm();
+  const Eigen::AngleAxisd relative(T_cam_world.linear() * T_cam_world_predicted.linear().transpose());
+  check.rotation_deg = std::abs(relative.angle()) * 180.0 / std::numbers::pi;
+  const double acceleration_term = dt > 0.0 ? 0.5 * options.max_acceleration * dt * dt : 0.0;
+  check.allowed_translation_m =
+      options.step_tolerance + options.step_tolerance_relative * std::max(0.0, predicted_step_m) + acceleration_term;
+  check.plausible = check.translation_m <= check.allowed_translation_m &&
+                    check.rotation_deg <= options.step_tolerance_rotation_deg;
+  return check;
+}
+
+}  // namespace rgbl

@@ -1,0 +1,84 @@
+// The state rule (rgbl/tracking/support.hpp): ok needs ORB-SLAM's 30 inliers, 50 within a second of a
+// relocalisation; a step is plausible within the pose noise, the velocity's error and 1 g.
+#include "rgbl/tracking/support.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+
+namespace {
+
+Eigen::Isometry3d camera_at(double x, double z, double yaw_deg = 0.0) {
+  // T_world_cam: at (x, 0, z), turned by yaw about the camera's y axis; returned as T_cam_world
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  T_world_cam.linear() = Eigen::AngleAxisd(yaw_deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  T_world_cam.translation() = Eigen::Vector3d(x, 0.0, z);
+  return T_world_cam.inverse();
+}
+
+}  // namespace
+
+TEST_CASE("support: ok needs 30 inliers, 50 within the relocalisation window", "[tracking][support]") {
+  const rgbl::TrackerOptions options;
+  using rgbl::TrackState;
+  CHECK(rgbl::support_state(30, std::nullopt, options) == TrackState::Ok);
+  CHECK(rgbl::support_state(29, std::nullopt, options) == TrackState::Weak);
+  CHECK(rgbl::support_state(4, std::nullopt, options) == TrackState::Weak);  // the real drive's frame 118+
+  CHECK(rgbl::support_state(0, std::nullopt, options) == TrackState::Weak);
+  // the relocalised frame itself and the next 9 need 50
+  CHECK(rgbl::support_state(49, 0, options) == TrackState::Weak);
+  CHECK(rgbl::support_state(50, 0, options) == TrackState::Ok);
+  CHECK(rgbl::support_state(49, 9, options) == TrackState::Weak);
+  CHECK(rgbl::support_state(30, 10, options) == TrackState::Ok);
+  CHECK(rgbl::support_state(29, 10, options) == TrackState::Weak);
+
+  CHECK(std::string(rgbl::to_string(TrackState::Weak)) == "weak");
+  CHECK(rgbl::has_pose(TrackState::Weak));
+  CHECK(rgbl::has_pose(TrackState::Ok));
+  CHECK_FALSE(rgbl::has_pose(TrackState::Lost));
+  CHECK_FALSE(rgbl::has_pose(TrackState::NotInitialised));
+}
+
+TEST_CASE("support: a step is plausible within pose noise, velocity error and 1 g", "[tracking][support]") {
+  const rgbl::TrackerOptions options;  // 0.25 m + 0.1 * step + 10 m/s^2 * dt^2 / 2, 3 deg
+  const Eigen::Isometry3d predicted = camera_at(0.0, 1.3);  // a 1.3 m step predicted, 0.1 s
+  const double allowed = 0.25 + 0.1 * 1.3 + 0.5 * 10.0 * 0.01;
+  const auto at = [&](double x, double z, double yaw = 0.0) {
+    return rgbl::check_step(camera_at(x, z, yaw), predicted, 1.3, 0.1, options);
+  };
+  CHECK(at(0.0, 1.3).plausible);
+  CHECK(at(0.0, 1.3).translation_m == Approx(0.0).margin(1e-12));
+  CHECK(at(0.0, 1.3).allowed_translation_m == Approx(allowed));
+  CHECK(at(0.0, 1.3 + allowed - 0.01).plausible);
+  CHECK_FALSE(at(0.0, 1.3 + allowed + 0.01).plausible);
+  CHECK(at(0.0, 1.3 + allowed + 0.01).translation_m == Approx(allowed + 0.01));
+  CHECK_FALSE(at(allowed + 0.01, 1.3).plausible);        // sideways counts the same
+  CHECK_FALSE(at(0.0, 3.7 * 1.3).plausible);              // the real drive's 3.7x steps
+  CHECK_FALSE(at(0.0, 1.3 + 8.4).plausible);              // and its 8.4 m jump
+  CHECK(at(0.0, 1.3, 2.9).plausible);
+  CHECK_FALSE(at(0.0, 1.3, 3.1).plausible);
+  CHECK(at(0.0, 1.3, 3.1).rotation_deg == Approx(3.1));
+  // a frame that comes late (dropped frames) may deviate more: the acceleration term grows with dt^2
+  const auto late = rgbl::check_step(camera_at(0.0, 1.3 + 0.6), predicted, 1.3, 0.3, options);
+  CHECK(late.allowed_translation_m == Approx(0.25 + 0.13 + 0.45));
+  CHECK(late.plausible);
+  // an unknown time difference adds nothing
+  CHECK(rgbl::check_step(predicted, predicted, 1.3, 0.0, options).allowed_translation_m == Approx(0.38));
+}
+
+TEST_CASE("support: the thresholds are validated", "[tracking][support]") {
+  rgbl::TrackerOptions options;
+  options.min_ok_inliers = 5;  // below min_pose_inliers (10)
+  CHECK_THROWS_WITH(options.validate(), Catch::Contains("tracker.min_ok_inliers"));
+  options = {};
+  options.min_ok_inliers_after_relocalisation = 20;
+  CHECK_THROWS_WITH(options.validate(), Catch::Contains("tracker.min_ok_inliers_after_relocalisation"));
+  options = {};
+  options.step_tolerance_rotation_deg = -1.0;
+  CHECK_THROWS_WITH(options.validate(), Catch::Contains("tracker.step_tolerance_rotation_deg"));
+  options = {};
+  options.max_acceleration = -1.0;
+  CHECK_THROWS_WITH(options.validate(), Catch::Contains("tracker.max_acceleration"));
+  CHECK_NOTHROW(rgbl::TrackerOptions{}.validate());
+}
