@@ -15,7 +15,8 @@
 namespace rgbl::test {
 
 struct SequenceRun {
-  std::size_t frames = 0, tracked = 0;
+  std::size_t frames = 0, tracked = 0;  // tracked: reported ok
+  std::size_t with_pose = 0;              // ok or weak: a pose was estimated
   std::vector<Eigen::Isometry3d> estimate;  // T_world_cam0, world = first cam0 (as poses/NN.txt)
   std::vector<Eigen::Isometry3d> truth;
   double ate_rmse = 0.0, drift_percent = 0.0;
@@ -41,7 +42,9 @@ inline SequenceRun run_sequence(const std::filesystem::path& dir, int camera, st
     frame.timestamp = input.timestamp;
     frame.image = input.images[static_cast<std::size_t>(camera)];
     frame.scan = input.scan;
-    run.tracked += system.track(frame).state == TrackState::Ok ? 1 : 0;
+    const TrackState state = system.track(frame).state;
+    run.tracked += state == TrackState::Ok ? 1 : 0;
+    run.with_pose += has_pose(state) ? 1 : 0;
   }
   system.finish();
   const Eigen::Isometry3d T_cam_cam0 = calibration.T_cam_cam0;
