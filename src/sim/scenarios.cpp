@@ -11,6 +11,18 @@ namespace {
 
 using sim_detail::Rng;
 
+// What every scenario shares: the look of KITTI's grey cameras at half resolution, tuned with
+// rgbl_image_stats against sequence 04 and raw drive 0009 (docs/synthetic.md): a steeper tone curve
+// (KITTI's sky is near white, its shadows near black), a slight lens blur, sensor noise, lower blocks
+// (more sky).
+void kitti_look(SyntheticOptions& o) {
+  o.contrast = 1.45;
+  o.lens_blur_sigma = 0.5;
+  o.image_noise_sigma = 1.5;
+  o.scene.building_min_height = 6.0;
+  o.scene.building_max_height = 18.0;
+}
+
 // The reference street: the generator's defaults on the curve (the demo's street without --scenario).
 void plain(SyntheticOptions&, Rng&) {}
 
@@ -71,8 +83,8 @@ void foliage(SyntheticOptions& o, Rng&) {
 // road and onto the facades, crowns dapple the light; the camera's auto exposure steps (+30 %, then -30 %) and drifts.
 void shadows(SyntheticOptions& o, Rng& rng) {
   o.light.sun_direction = Eigen::Vector3d(-0.39, -0.77, 0.51);  // 50 deg high
-  o.light.ambient = 0.45;
-  o.light.sun = 0.85;
+  o.light.ambient = 0.5;
+  o.light.sun = 0.95;
   o.light.cast_shadows = true;
   o.scene.tree_spacing = 9.0;
   const int first = 15 + static_cast<int>(rng.uniform(0.0, 6.0));
@@ -126,6 +138,7 @@ SyntheticOptions scenario_options(std::string_view name, std::uint64_t seed, int
     o.seed = seed;
     o.frames = frames > 0 ? frames : e.info.default_frames;
     o.path.kind = PathKind::curve;
+    kitti_look(o);
     // the scenario's own draws (actors, event frames) from the seed and its name, apart from the street's
     std::uint64_t salt = 0;
     for (const char c : name) salt = sim_detail::mix64(salt, static_cast<unsigned char>(c));

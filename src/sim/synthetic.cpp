@@ -375,6 +375,8 @@ void SyntheticOptions::validate() const {
   require(exposure_drift_period >= 2.0, "exposure_drift_period", "at least 2 frames");
   require(exposure_time >= 0.0 && exposure_time <= 0.1, "exposure_time", "an exposure in [0, 0.1] s");
   require(lens_blur_sigma >= 0.0 && lens_blur_sigma <= 5.0, "lens_blur_sigma", "a sigma in [0, 5] pixels");
+  require(contrast > 0.1 && contrast <= 4.0, "contrast", "a factor in (0.1, 4]");
+  require(contrast_pivot >= 0.0 && contrast_pivot <= 255.0, "contrast_pivot", "a grey level in [0, 255]");
   if (path.kind == PathKind::loop) {
     require(driven_length() >= 2.0 * std::numbers::pi * path.loop_corner_radius, "frames",
             "enough frames for the loop: (frames - 1) * speed * frame_period >= 2 pi path.loop_corner_radius");
@@ -532,6 +534,9 @@ cv::Mat SyntheticGenerator::render_image(int frame, int camera) const {
                      cv::BORDER_REPLICATE);
   }
   const auto gain = static_cast<float>(exposure_gain(frame));
+  const auto contrast = static_cast<float>(options_.contrast), pivot = static_cast<float>(options_.contrast_pivot);
+  // the tone curve, in grey levels; the identity (bit for bit) at contrast 1
+  auto tone = [contrast, pivot](float level) { return contrast == 1.0F ? level : pivot + contrast * (level - pivot); };
   cv::Mat image(cam.height, cam.width, colour ? CV_8UC3 : CV_8UC1);
   parallel_for(cam.height, options_.threads, [&](int v) {
     auto* row = image.ptr<std::uint8_t>(v);
@@ -541,12 +546,12 @@ cv::Mat SyntheticGenerator::render_image(int frame, int camera) const {
       const std::uint64_t h = sim_detail::mix64(noise_key, static_cast<std::uint64_t>(v) * 65536U + static_cast<std::uint64_t>(u));
       if (colour) {
         // OpenCV's channel order: B, G, R.
-        row[3 * u + 0] = to_byte(sum[2] * 63.75F + sigma * pixel_noise(sim_detail::mix64(h, 0)));
-        row[3 * u + 1] = to_byte(sum[1] * 63.75F + sigma * pixel_noise(sim_detail::mix64(h, 1)));
-        row[3 * u + 2] = to_byte(sum[0] * 63.75F + sigma * pixel_noise(sim_detail::mix64(h, 2)));
+        row[3 * u + 0] = to_byte(tone(sum[2] * 63.75F) + sigma * pixel_noise(sim_detail::mix64(h, 0)));
+        row[3 * u + 1] = to_byte(tone(sum[1] * 63.75F) + sigma * pixel_noise(sim_detail::mix64(h, 1)));
+        row[3 * u + 2] = to_byte(tone(sum[0] * 63.75F) + sigma * pixel_noise(sim_detail::mix64(h, 2)));
       } else {
         const float grey = (0.299F * sum[0] + 0.587F * sum[1] + 0.114F * sum[2]) * 63.75F;
-        row[u] = to_byte(grey + sigma * pixel_noise(h));
+        row[u] = to_byte(tone(grey) + sigma * pixel_noise(h));
       }
     }
   });

@@ -107,6 +107,10 @@ struct SyntheticOptions {
   double exposure_time = 0.0;            // s
   // Optics: a Gaussian point spread, pixels (KITTI's images are not pixel-sharp); 0 = none.
   double lens_blur_sigma = 0.0;
+  // Tone: grey levels are stretched by this factor about `contrast_pivot` (before the noise), like a
+  // camera's response that puts the sky near white and the shadows near black; 1 = linear.
+  double contrast = 1.0;
+  double contrast_pivot = 90.0;  // grey level that stays where it is
   std::array<bool, 4> cameras{true, true, true, true};  // which images render() makes (the rest stay empty)
   bool render_depth = true;                             // whether render() makes the exact depth image
   int threads = 2;                       // threads used to render one frame
