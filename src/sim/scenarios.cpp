@@ -26,11 +26,11 @@ void kitti_look(SyntheticOptions& o) {
 // The reference street: the generator's defaults on the curve (the demo's street without --scenario).
 void plain(SyntheticOptions&, Rng&) {}
 
-// A van in the ego lane, 6.5-7.5 m ahead, at exactly the camera's speed for the whole run: it stands
+// A van in the ego lane, 5.5-6.5 m ahead, at exactly the camera's speed for the whole run: it stands
 // still in the image while the street streams past, and covers 10-25 % of it.
 void lead_vehicle(SyntheticOptions& o, Rng& rng) {
   Actor van = make_vehicle(VehicleKind::van, rng.next32());
-  van.s0 = rng.uniform(6.5, 7.5) + 0.5 * van.length();
+  van.s0 = rng.uniform(5.5, 6.5) + 0.5 * van.length();
   van.speed = o.speed;
   van.speed_phases = o.speed_phases;
   o.actors.push_back(van);
@@ -111,7 +111,7 @@ struct Entry {
 
 constexpr std::array<Entry, 6> kScenarios{{
     {{"plain", "the reference street: 30 m straight, a gentle 60 deg bend (radius 40 m), 10 m/s", 60}, plain},
-    {{"lead-vehicle", "a van 7 m ahead in the ego lane at the ego speed for the whole run (10-25 % of the image)", 60},
+    {{"lead-vehicle", "a van 6 m ahead in the ego lane at the ego speed for the whole run (10-25 % of the image)", 60},
      lead_vehicle},
     {{"traffic", "cars and trucks in three other lanes, both directions; the ego brakes at 3.5 m/s^2 and stands 2 s", 80},
      traffic},

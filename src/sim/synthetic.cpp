@@ -54,7 +54,9 @@ float pixel_noise(std::uint64_t h) {
 class FrameScene {
  public:
   FrameScene(const StreetScene& scene, std::vector<SceneObject> actors)
-      : scene_(scene), actors_(std::move(actors)), static_count_(static_cast<std::uint32_t>(scene.objects().size())) {}
+      : scene_(scene), actors_(std::move(actors)), static_count_(static_cast<std::uint32_t>(scene.objects().size())) {
+    for (const SceneObject& a : actors_) bounds_.push_back({{a.cx, a.cy, a.cz}, std::sqrt(a.hx * a.hx + a.hy * a.hy + a.hz * a.hz)});
+  }
 
   const StreetScene& street() const { return scene_; }
   const std::vector<SceneObject>& actors() const { return actors_; }
@@ -69,7 +71,13 @@ class FrameScene {
     std::optional<RayHit> hit = scene_.intersect(origin, d, t_max, t_min);
     double best = hit ? hit->t : t_max;
     std::uint8_t face = 0;
+    const double dd = d.squaredNorm();
     for (std::size_t k = 0; k < actors_.size(); ++k) {
+      // a cheap test against the box's bounding sphere first: most rays pass far from most vehicles
+      const Eigen::Vector3d oc = bounds_[k].centre - origin;
+      const double along = oc.dot(d) / dd, r2 = bounds_[k].radius * bounds_[k].radius;
+      if ((along < 0.0 && oc.squaredNorm() > r2) || (oc - along * d).squaredNorm() > r2) continue;
+      if (along - bounds_[k].radius / std::sqrt(dd) >= best) continue;  // beyond what was hit already
       if (intersect_object(actors_[k], origin, d, t_min, best, face)) {
         hit = RayHit{best, static_count_ + static_cast<std::uint32_t>(k), face};
       }
@@ -83,8 +91,13 @@ class FrameScene {
   }
 
  private:
+  struct Sphere {
+    Eigen::Vector3d centre;
+    double radius;
+  };
   const StreetScene& scene_;
   std::vector<SceneObject> actors_;
+  std::vector<Sphere> bounds_;
   std::uint32_t static_count_;
 };
 
