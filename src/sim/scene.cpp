@@ -181,6 +181,7 @@ void StreetOptions::validate() const {
           "a probability in [0, 1]");
   require(pole_spacing >= 2.0, "scene.pole_spacing", "at least 2 m");
   require(tree_spacing >= 2.0, "scene.tree_spacing", "at least 2 m");
+  require(tree_offset >= 0.3 && tree_offset <= sidewalk_width, "scene.tree_offset", "0.3 m up to the sidewalk's width");
   require(hedge_height >= 0.0 && hedge_height <= 10.0, "scene.hedge_height", "a height in [0, 10] m (0 = no hedge)");
   require(hedge_offset >= 0.0 && hedge_depth >= 0.1 && hedge_offset + hedge_depth <= sidewalk_width,
           "scene.hedge_offset", "hedge_offset >= 0, hedge_depth >= 0.1 m, both within the sidewalk");
@@ -487,7 +488,7 @@ StreetScene::StreetScene(const DrivePath& path, const StreetOptions& options, st
       const double trunk_r = rng.uniform(0.12, 0.22), trunk_h = rng.uniform(2.6, 3.6), crown_r = rng.uniform(1.3, 2.3);
       const std::uint32_t tseed = rng.next32();
       if (side == 0 && o.hedge_height > 0.0) continue;
-      const Eigen::Vector2d c = Eigen::Vector2d(p.x, p.z) + (kerb[side] + side_sign[side] * 1.3) * p.right();
+      const Eigen::Vector2d c = Eigen::Vector2d(p.x, p.z) + (kerb[side] + side_sign[side] * o.tree_offset) * p.right();
       const SceneObject trunk = cylinder(SurfaceKind::bark, tseed, c, trunk_r, ground_y_, trunk_h + 0.5 * crown_r);
       if (clearance.distance(footprint(trunk)) < o.road_half_width + 0.5) continue;
       SceneObject crown;

@@ -109,7 +109,7 @@ TEST_CASE("the scenario registry lists every scenario, each with its options and
     CHECK(rgbl::scenario_options(s.name, 3, 20).frames == 20);
   }
   CHECK(list.front().name == "plain");
-  for (const char* required : {"plain", "lead-vehicle", "traffic", "foliage", "shadows", "turn"}) {
+  for (const char* required : {"plain", "lead-vehicle", "traffic", "foliage", "shadows", "turn", "suburban"}) {
     CHECK(names.count(required) == 1);
   }
   try {
@@ -296,6 +296,22 @@ TEST_CASE("shadows: cast shadows darken the road, the exposure steps and drifts"
              WithinAbs(0.7, 0.03));
   const double before = cv::mean(g.render_image(step - 1, 0))[0], after = cv::mean(g.render_image(step, 0))[0];
   CHECK(after > 1.15 * before);
+}
+
+TEST_CASE("suburban: the stresses together, the car ahead at the ego speed for the last 40 frames") {
+  const rgbl::SyntheticOptions o = rgbl::scenario_options("suburban", 1);
+  CHECK(o.scene.hedge_height > 0.0);
+  CHECK(o.light.cast_shadows);
+  CHECK(o.exposure_time > 0.0);
+  REQUIRE(o.actors.size() == 1);
+  const rgbl::SyntheticGenerator g(o);
+  const rgbl::SpeedProfile car(o.actors[0].speed, o.actors[0].speed_phases);
+  const auto gap = [&](int f) { return o.actors[0].s0 + car.distance(g.timestamp(f)) - g.arc_length(f); };
+  CHECK(gap(0) > gap(30));
+  for (int f = o.frames - 40; f < o.frames; ++f) CHECK_THAT(gap(f), WithinAbs(gap(o.frames - 40), 1e-9));
+  const double share = actor_share(g, o.frames - 1);
+  CHECK(share > 0.01);
+  CHECK(share < 0.10);
 }
 
 TEST_CASE("scenarios are deterministic: same seed and options, same bytes, whatever the thread count") {

@@ -32,6 +32,7 @@ struct StreetOptions {
   double container_probability = 0.12; // share of the taken slots holding a container
   double pole_spacing = 16.0;     // m, mean distance between poles along each kerb
   double tree_spacing = 14.0;     // m, mean distance between trees along each sidewalk
+  double tree_offset = 1.3;       // m, kerb to the trunks (crowns that would reach the driving lanes are left out)
   // A dense hedge along the right kerb instead of poles, trees and bins on that sidewalk (0 = none).
   double hedge_height = 0.0;      // m, mean height (it varies by +-15 % from piece to piece)
   double hedge_offset = 0.3;      // m, kerb to the hedge's road-side face
