@@ -100,6 +100,19 @@ class SequenceWriter {
                        o.frames, to_string(o.path.kind), o.speed, o.frame_period, o.width, o.height);
     out << fmt::format("image_noise_sigma: {}\ndepth_camera: {}\nlidar_range_noise_sigma: {}\nlidar_dropout: {}\n",
                        o.image_noise_sigma, o.depth_camera, o.lidar.range_noise_sigma, o.lidar.dropout);
+    if (!o.speed_phases.empty()) {
+      out << "speed_phases:";
+      for (const SpeedPhase& p : o.speed_phases) out << fmt::format(" {}s@{}m/s2", p.duration, p.acceleration);
+      out << '\n';
+    }
+    if (!o.actors.empty()) out << fmt::format("actors: {}\n", o.actors.size());
+    if (o.light.cast_shadows) out << "cast_shadows: true\n";
+    if (o.exposure_time > 0.0) out << fmt::format("exposure_time: {}\n", o.exposure_time);
+    if (!o.exposure_steps.empty() || o.exposure_drift > 0.0) {
+      out << "exposure_gain:";
+      for (const ExposureStep& e : o.exposure_steps) out << fmt::format(" x{} from frame {};", e.gain, e.frame);
+      out << fmt::format(" drift {} over {} frames\n", o.exposure_drift, o.exposure_drift_period);
+    }
     if (o.untextured) out << fmt::format("untextured: {} {}\n", o.untextured->first, o.untextured->last);
     if (!o.dropped_scans.empty()) out << fmt::format("dropped_scans: {}\n", fmt::join(o.dropped_scans, " "));
     if (!out) throw Error(fmt::format("cannot write {}", file.string()));
