@@ -90,10 +90,12 @@ int main(int argc, char** argv) {
       if (!quiet) fmt::print("frame {:4d}/{}: {:.0f} ms (render and write)\n", i + 1, o.frames, ms);
     });
     fmt::print("wrote {} frames of {} ({}x{}, seed {}) to {} in {:.1f} s ({:.0f} ms per frame)\n", o.frames,
-               scenario.empty() ? "a " + path + " path" : "scenario " + scenario, o.width, o.height, o.seed, layout.sequence_dir.string(), total.elapsed_ms() / 1000.0,
-               render_ms / o.frames);
+               scenario.empty() ? "a " + path + " path" : "scenario " + scenario, o.width, o.height, o.seed,
+               layout.sequence_dir.string(), total.elapsed_ms() / 1000.0, render_ms / o.frames);
     fmt::print("ground truth: {}", layout.poses_file.string());
-    if (o.render_depth) fmt::print("; exact depth of camera {}: {}", o.depth_camera, (layout.sequence_dir / "depth").string());
+    if (o.render_depth) {
+      fmt::print("; exact depth of camera {}: {}", o.depth_camera, (layout.sequence_dir / "depth").string());
+    }
     fmt::print("\n");
   } catch (const std::exception& e) {
     fmt::print(stderr, "rgbl_sim: {}\n", e.what());

@@ -23,7 +23,8 @@ void kitti_look(SyntheticOptions& o) {
   o.scene.building_max_height = 18.0;
 }
 
-// The reference street: the generator's defaults on the curve (the demo's street without --scenario).
+// The reference street: the curve of the generator's defaults (the demo's street without --scenario),
+// with the shared look.
 void plain(SyntheticOptions&, Rng&) {}
 
 // A van in the ego lane, 5.5-6.5 m ahead, at exactly the camera's speed for the whole run: it stands
@@ -80,8 +81,9 @@ void foliage(SyntheticOptions& o, Rng&) {
   o.lidar.foliage_penetration = 0.2;
 }
 
-// The sun 50 deg high from the front left: buildings, cars and trees cast hard shadows over part of the
-// road and onto the facades, crowns dapple the light; the camera's auto exposure steps (+30 %, then -30 %) and drifts.
+// The sun 50 deg high from the front left: buildings, cars and trees cast hard shadows over part of
+// the road and onto the facades, crowns dapple the light; the camera's auto exposure steps (+30 %,
+// then -30 %) and drifts.
 void shadows(SyntheticOptions& o, Rng& rng) {
   o.light.sun_direction = Eigen::Vector3d(-0.39, -0.77, 0.51);  // 50 deg high
   o.light.ambient = 0.5;
@@ -142,10 +144,15 @@ constexpr std::array<Entry, 7> kScenarios{{
      traffic},
     {{"foliage", "a dense hedge 2.25 m to the right, trees on the left, 8 ms motion blur, LiDAR sinking into leaves", 60},
      foliage},
-    {{"shadows", "sun from the front left: cast and dappled shadows on road and facades; exposure steps +-30 %, drift", 60}, shadows},
+    {{"shadows", "sun from the front left: cast and dappled shadows on road and facades; exposure steps +-30 %, drift",
+      60},
+     shadows},
     {{"turn", "a 90 deg left turn of 12 m radius at 4.5 m/s between buildings, braking before, accelerating after", 85},
      turn},
-    {{"suburban", "issue 13's failing drive: hedge, leaf shadows, blur, 12 m/s, a car 12 m ahead at ego speed for the last 40 frames, a gentle curve", 100},
+    {{"suburban",
+      "issue 13's failing drive: hedge, leaf shadows, blur, 12 m/s, a car 12 m ahead at ego speed for the last "
+      "40 frames, a gentle curve",
+      100},
      suburban},
 }};
 

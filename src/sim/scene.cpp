@@ -518,8 +518,8 @@ StreetScene::StreetScene(const DrivePath& path, const StreetOptions& options, st
       s += len;
       const Eigen::Vector2d chord = b - a;
       // overlap the neighbours a little so that no gap opens in bends
-      objects_.push_back(upright_box(SurfaceKind::foliage, hseed, 0.5 * (a + b), chord.normalized(), 0.5 * chord.norm() + 0.05,
-                                     0.5 * o.hedge_depth, ground_y_, 0.0, height));
+      objects_.push_back(upright_box(SurfaceKind::foliage, hseed, 0.5 * (a + b), chord.normalized(),
+                                     0.5 * chord.norm() + 0.05, 0.5 * o.hedge_depth, ground_y_, 0.0, height));
     }
   }
   build_grid();

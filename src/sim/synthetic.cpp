@@ -55,7 +55,9 @@ class FrameScene {
  public:
   FrameScene(const StreetScene& scene, std::vector<SceneObject> actors)
       : scene_(scene), actors_(std::move(actors)), static_count_(static_cast<std::uint32_t>(scene.objects().size())) {
-    for (const SceneObject& a : actors_) bounds_.push_back({{a.cx, a.cy, a.cz}, std::sqrt(a.hx * a.hx + a.hy * a.hy + a.hz * a.hz)});
+    for (const SceneObject& a : actors_) {
+      bounds_.push_back({{a.cx, a.cy, a.cz}, std::sqrt(a.hx * a.hx + a.hy * a.hy + a.hz * a.hz)});
+    }
   }
 
   const StreetScene& street() const { return scene_; }
@@ -619,7 +621,8 @@ std::vector<LidarPoint> SyntheticGenerator::render_scan(int frame) const {
       double range = hit->t + (lo.range_noise_sigma > 0.0 ? lo.range_noise_sigma * sim_detail::gaussian(h) : 0.0);
       if (lo.foliage_penetration > 0.0 && surface.kind == SurfaceKind::foliage) {
         // half-normal with the given mean: the beam goes some way into the leaves before it returns
-        range += lo.foliage_penetration * std::sqrt(std::numbers::pi / 2.0) * std::abs(sim_detail::gaussian(sim_detail::mix64(h, 11)));
+        const double depth = std::abs(sim_detail::gaussian(sim_detail::mix64(h, 11)));
+        range += lo.foliage_penetration * std::sqrt(std::numbers::pi / 2.0) * depth;
       }
       const Rgb a = sim_detail::albedo(surface, 0.003 * hit->t);
       const Eigen::Vector3d p = range * dir;
