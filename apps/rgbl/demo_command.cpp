@@ -1,4 +1,5 @@
-// rgbl demo [--frames N] [--path straight|curve|loop] [--seed S] [--depth SPEC] [--out DIR] [--keep DIR]
+// rgbl demo [--scenario NAME|list] [--frames N] [--path straight|curve|loop] [--seed S] [--depth SPEC] [--out DIR]
+//           [--keep DIR]
 // The main job without a dataset: generates a synthetic street (rgbl::sim) in the KITTI odometry layout
 // and tracks it through exactly the code of `rgbl run` (make_pipeline + run_pipeline), so the accuracy
 // printed is against the exact ground truth.
@@ -8,6 +9,7 @@
 
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/timer.hpp"
+#include "rgbl/sim/scenarios.hpp"
 #include "rgbl/sim/synthetic.hpp"
 
 #include <fmt/format.h>
@@ -32,8 +34,9 @@ namespace {
 namespace fs = std::filesystem;
 
 struct DemoArgs {
-  int frames = 0;  // 0: 60 (a bend of the curve), 80 for a loop (the shortest that closes)
+  int frames = 0;  // 0: 60 (a bend of the curve), 80 for a loop (the shortest that closes), a scenario's own
   std::string path = "curve";
+  std::string scenario;  // empty: the street of --path
   std::uint64_t seed = 1;
   std::string depth = "lidar";
   std::string out = "rgbl_demo_output";
@@ -63,12 +66,26 @@ class TempFolder {
   fs::path path_;
 };
 
+void print_scenarios() {
+  for (const ScenarioInfo& s : scenarios()) {
+    fmt::print("{:<14} {} (default {} frames)\n", s.name, s.description, s.default_frames);
+  }
+}
+
 int run_demo(const DemoArgs& args, bool quiet) {
+  if (args.scenario == "list") {
+    print_scenarios();
+    return 0;
+  }
   SyntheticOptions sim;
-  sim.frames = args.frames > 0 ? args.frames : (args.path == "loop" ? 80 : 60);
-  sim.seed = args.seed;
-  sim.path.kind = *parse_path_kind(args.path);  // CLI11 checked the name
-  sim.depth_camera = 0;                          // the exact depth of the camera `run` tracks by default
+  if (!args.scenario.empty()) {
+    sim = scenario_options(args.scenario, args.seed, args.frames);  // throws naming "scenario"
+  } else {
+    sim.frames = args.frames > 0 ? args.frames : (args.path == "loop" ? 80 : 60);
+    sim.seed = args.seed;
+    sim.path.kind = *parse_path_kind(args.path);  // CLI11 checked the name
+  }
+  sim.depth_camera = 0;  // the exact depth of the camera `run` tracks by default
   if (sim.path.kind == PathKind::loop) {
     // the loop's perimeter is the distance driven: shrink the corners (down to the generator's 12 m)
     // so that a shorter demo still closes its loop
@@ -81,7 +98,6 @@ int run_demo(const DemoArgs& args, bool quiet) {
                                                 radius));
     }
   }
-  sim.validate();
 
   // refuse what cannot work before spending the generation time on it
   const std::string depth_name = args.depth.substr(0, args.depth.find(':'));
@@ -91,6 +107,11 @@ int run_demo(const DemoArgs& args, bool quiet) {
                                              "exact depth), not '{}'",
                                              args.depth));
   }
+  // render only what tracking camera 0 with this depth source reads: the right image for stereo, the
+  // exact depth for `precomputed` alone; the scan is always written (the KITTI layout's velodyne/)
+  sim.cameras = {true, depth_name == "stereo", false, false};
+  sim.render_depth = args.depth == "precomputed";
+  sim.validate();
 
   std::optional<TempFolder> temp;
   fs::path root;
@@ -115,8 +136,9 @@ int run_demo(const DemoArgs& args, bool quiet) {
   });
   if (!quiet && tty) fmt::print(stderr, "\n");
   const double generation_s = generation.elapsed_ms() / 1000.0;
-  fmt::print("synthetic street: {} frames of a {} path ({}x{}, seed {}, {:.0f} m) generated in {:.1f} s\n",
-             sim.frames, args.path, sim.width, sim.height, sim.seed, (sim.frames - 1) * sim.step(), generation_s);
+  fmt::print("synthetic street: {} frames of {} ({}x{}, seed {}, {:.0f} m) generated in {:.1f} s ({:.0f} ms per frame)\n",
+             sim.frames, args.scenario.empty() ? fmt::format("a {} path", args.path) : "scenario " + args.scenario,
+             sim.width, sim.height, sim.seed, sim.driven_length(), generation_s, 1000.0 * generation_s / sim.frames);
   std::fflush(stdout);  // before the run's progress on stderr
 
   InputOptions input;
@@ -145,11 +167,14 @@ Command add_demo_command(CLI::App& parent) {
   auto* app = parent.add_subcommand(
       "demo", "Generate a synthetic street with exact ground truth and track it like `rgbl run` (no dataset needed)");
   auto args = std::make_shared<DemoArgs>();
-  app->add_option("--frames", args->frames, "Frames to generate and track, 1 m apart (default: 60; 80 for a loop, which needs >= 77)")
+  app->add_option("--frames", args->frames, "Frames to generate and track (default: 60; 80 for a loop, which needs >= 77; a scenario's own)")
       ->check(CLI::Range(2, 100000));
-  app->add_option("--path", args->path, "Camera path")
-      ->check(CLI::IsMember({"straight", "curve", "loop"}))
-      ->capture_default_str();
+  auto* path = app->add_option("--path", args->path, "Camera path")
+                   ->check(CLI::IsMember({"straight", "curve", "loop"}))
+                   ->capture_default_str();
+  app->add_option("--scenario", args->scenario,
+                  "A stress scenario instead of --path (`--scenario list` prints them; `plain` is the reference)")
+      ->excludes(path);
   app->add_option("--seed", args->seed, "Seed of the scene and all noise")->capture_default_str();
   app->add_option("--depth", args->depth,
                   "Depth source as for `rgbl run`: lidar (5x5 diamond), lidar:ipbasic, lidar:diamond7, stereo, "

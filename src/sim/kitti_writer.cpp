@@ -17,9 +17,12 @@ class SequenceWriter {
   SequenceWriter(const std::filesystem::path& root, int sequence, const SyntheticOptions& options,
                  const KittiCalibration& calibration)
       : layout_(kitti_layout(root, sequence)) {
-    for (const char* dir : {"image_0", "image_1", "image_2", "image_3", "velodyne", "depth"}) {
-      std::filesystem::create_directories(layout_.sequence_dir / dir);
+    // only the folders of what is rendered: the KITTI loader takes a camera folder as the camera's presence
+    for (std::size_t c = 0; c < 4; ++c) {
+      if (options.cameras[c]) std::filesystem::create_directories(layout_.sequence_dir / fmt::format("image_{}", c));
     }
+    std::filesystem::create_directories(layout_.sequence_dir / "velodyne");
+    if (options.render_depth) std::filesystem::create_directories(layout_.sequence_dir / "depth");
     std::filesystem::create_directories(layout_.poses_file.parent_path());
     write_calibration(calibration);
     write_options(options);
@@ -32,17 +35,10 @@ class SequenceWriter {
   void add(const SyntheticFrame& f) {
     const std::string name = fmt::format("{:06d}", f.index);
     for (int c = 0; c < 4; ++c) {
-      write_png(layout_.sequence_dir / fmt::format("image_{}", c) / (name + ".png"), f.images[static_cast<std::size_t>(c)]);
+      const cv::Mat& image = f.images[static_cast<std::size_t>(c)];
+      if (!image.empty()) write_png(layout_.sequence_dir / fmt::format("image_{}", c) / (name + ".png"), image);
     }
-    // Depth as uint16 = depth * 256 (KITTI depth-completion convention); beyond 255.99 m: 0.
-    cv::Mat depth16(f.depth.rows, f.depth.cols, CV_16UC1);
-    for (int v = 0; v < f.depth.rows; ++v) {
-      for (int u = 0; u < f.depth.cols; ++u) {
-        const double scaled = std::round(static_cast<double>(f.depth(v, u)) * 256.0);
-        depth16.at<std::uint16_t>(v, u) = scaled > 0.0 && scaled <= 65535.0 ? static_cast<std::uint16_t>(scaled) : 0;
-      }
-    }
-    write_png(layout_.sequence_dir / "depth" / (name + ".png"), depth16);
+    if (!f.depth.empty()) write_depth(layout_.sequence_dir / "depth" / (name + ".png"), f.depth);
     const auto bin = layout_.sequence_dir / "velodyne" / (name + ".bin");
     std::ofstream out(bin, std::ios::binary);
     if (!f.scan.empty()) {  // a dropped scan is an empty file
@@ -71,6 +67,18 @@ class SequenceWriter {
     return s;
   }
 
+  static void write_depth(const std::filesystem::path& file, const cv::Mat_<float>& depth) {
+    // uint16 = depth * 256 (KITTI depth-completion convention); beyond 255.99 m: 0.
+    cv::Mat depth16(depth.rows, depth.cols, CV_16UC1);
+    for (int v = 0; v < depth.rows; ++v) {
+      for (int u = 0; u < depth.cols; ++u) {
+        const double scaled = std::round(static_cast<double>(depth(v, u)) * 256.0);
+        depth16.at<std::uint16_t>(v, u) = scaled > 0.0 && scaled <= 65535.0 ? static_cast<std::uint16_t>(scaled) : 0;
+      }
+    }
+    write_png(file, depth16);
+  }
+
   static void write_png(const std::filesystem::path& file, const cv::Mat& image) {
     if (!cv::imwrite(file.string(), image)) throw Error(fmt::format("cannot write {}", file.string()));
   }
@@ -87,10 +95,24 @@ class SequenceWriter {
     const auto file = layout_.sequence_dir / "sim.txt";
     std::ofstream out(file);
     out << "# rgbl synthetic street (rgbl_sim); depth/ holds camera " << o.depth_camera << "'s exact depth\n";
+    if (!o.scenario.empty()) out << fmt::format("scenario: {}\n", o.scenario);
     out << fmt::format("seed: {}\nframes: {}\npath: {}\nspeed: {}\nframe_period: {}\nwidth: {}\nheight: {}\n", o.seed,
                        o.frames, to_string(o.path.kind), o.speed, o.frame_period, o.width, o.height);
     out << fmt::format("image_noise_sigma: {}\ndepth_camera: {}\nlidar_range_noise_sigma: {}\nlidar_dropout: {}\n",
                        o.image_noise_sigma, o.depth_camera, o.lidar.range_noise_sigma, o.lidar.dropout);
+    if (!o.speed_phases.empty()) {
+      out << "speed_phases:";
+      for (const SpeedPhase& p : o.speed_phases) out << fmt::format(" {}s@{}m/s2", p.duration, p.acceleration);
+      out << '\n';
+    }
+    if (!o.actors.empty()) out << fmt::format("actors: {}\n", o.actors.size());
+    if (o.light.cast_shadows) out << "cast_shadows: true\n";
+    if (o.exposure_time > 0.0) out << fmt::format("exposure_time: {}\n", o.exposure_time);
+    if (!o.exposure_steps.empty() || o.exposure_drift > 0.0) {
+      out << "exposure_gain:";
+      for (const ExposureStep& e : o.exposure_steps) out << fmt::format(" x{} from frame {};", e.gain, e.frame);
+      out << fmt::format(" drift {} over {} frames\n", o.exposure_drift, o.exposure_drift_period);
+    }
     if (o.untextured) out << fmt::format("untextured: {} {}\n", o.untextured->first, o.untextured->last);
     if (!o.dropped_scans.empty()) out << fmt::format("dropped_scans: {}\n", fmt::join(o.dropped_scans, " "));
     if (!out) throw Error(fmt::format("cannot write {}", file.string()));

@@ -34,6 +34,7 @@ std::string_view to_string(PathKind kind) {
     case PathKind::straight: return "straight";
     case PathKind::curve: return "curve";
     case PathKind::loop: return "loop";
+    case PathKind::turn: return "turn";
   }
   return "unknown";
 }
@@ -42,6 +43,7 @@ std::optional<PathKind> parse_path_kind(std::string_view name) {
   if (name == "straight") return PathKind::straight;
   if (name == "curve") return PathKind::curve;
   if (name == "loop") return PathKind::loop;
+  if (name == "turn") return PathKind::turn;
   return std::nullopt;
 }
 
@@ -50,6 +52,43 @@ void PathOptions::validate() const {
   require(bend_angle_deg > 0.0 && bend_angle_deg <= 180.0, "path.bend_angle_deg", "an angle in (0, 180] degrees");
   require(bend_straight >= 0.0, "path.bend_straight", "a length >= 0 m");
   require(loop_corner_radius >= 12.0, "path.loop_corner_radius", "a radius of at least 12 m");
+  require(std::isfinite(turn_start) && turn_start >= 0.0, "path.turn_start", "a length >= 0 m");
+  require(turn_radius >= 8.0 && turn_radius <= 1000.0, "path.turn_radius", "a radius in [8, 1000] m");
+  require(turn_angle_deg != 0.0 && std::abs(turn_angle_deg) <= 180.0, "path.turn_angle_deg",
+          "a non-zero angle in [-180, 180] degrees");
+}
+
+SpeedProfile::SpeedProfile(double initial_speed, std::vector<SpeedPhase> phases, const char* key) {
+  require(std::isfinite(initial_speed) && initial_speed >= 0.0, key, "an initial speed >= 0 m/s");
+  double t = 0.0, v = initial_speed, d = 0.0;
+  for (const SpeedPhase& p : phases) {
+    require(std::isfinite(p.duration) && p.duration >= 0.0 && std::isfinite(p.acceleration), key,
+            "phases of finite duration >= 0 s and finite acceleration");
+    knots_.push_back({t, v, d, p.acceleration});
+    double v_end = v + p.acceleration * p.duration;
+    require(v_end > -1e-9, key, "phases that never make the speed negative");
+    if (std::abs(v_end) < 1e-9) v_end = 0.0;  // stopped means standing exactly still
+    d += 0.5 * (v + v_end) * p.duration;
+    t += p.duration;
+    v = v_end;
+  }
+  knots_.push_back({t, v, d, 0.0});
+}
+
+double SpeedProfile::speed(double t) const {
+  auto it = std::upper_bound(knots_.begin(), knots_.end(), t, [](double x, const Knot& k) { return x < k.t; });
+  const Knot& k = it == knots_.begin() ? knots_.front() : *std::prev(it);
+  if (&k == &knots_.back()) return k.speed;
+  return k.speed + k.acceleration * (t - k.t);
+}
+
+double SpeedProfile::distance(double t) const {
+  auto it = std::upper_bound(knots_.begin(), knots_.end(), t, [](double x, const Knot& k) { return x < k.t; });
+  const Knot& k = it == knots_.begin() ? knots_.front() : *std::prev(it);
+  const double dt = t - k.t;
+  if (&k == &knots_.back() || k.acceleration == 0.0) return k.distance + k.speed * dt;
+  // a phase that brakes to 0 before its end is excluded by the constructor, so no clamping here
+  return k.distance + k.speed * dt + 0.5 * k.acceleration * dt * dt;
 }
 
 Eigen::Vector2d PathPoint::forward() const { return {std::sin(heading), std::cos(heading)}; }
@@ -71,6 +110,14 @@ DrivePath::DrivePath(const PathOptions& options, double length) {
         segments_.push_back({arc, sign / options.bend_radius});
         covered += options.bend_straight + arc;
       }
+      break;
+    }
+    case PathKind::turn: {
+      const double angle = std::abs(options.turn_angle_deg) * std::numbers::pi / 180.0;
+      const double sign = options.turn_angle_deg > 0.0 ? 1.0 : -1.0;
+      if (options.turn_start > 0.0) segments_.push_back({options.turn_start, 0.0});
+      segments_.push_back({options.turn_radius * angle, sign / options.turn_radius});
+      segments_.push_back({std::max(1.0, length + kOpenMargin - options.turn_start - options.turn_radius * angle), 0.0});
       break;
     }
     case PathKind::loop: {

@@ -181,6 +181,10 @@ void StreetOptions::validate() const {
           "a probability in [0, 1]");
   require(pole_spacing >= 2.0, "scene.pole_spacing", "at least 2 m");
   require(tree_spacing >= 2.0, "scene.tree_spacing", "at least 2 m");
+  require(tree_offset >= 0.3 && tree_offset <= sidewalk_width, "scene.tree_offset", "0.3 m up to the sidewalk's width");
+  require(hedge_height >= 0.0 && hedge_height <= 10.0, "scene.hedge_height", "a height in [0, 10] m (0 = no hedge)");
+  require(hedge_offset >= 0.0 && hedge_depth >= 0.1 && hedge_offset + hedge_depth <= sidewalk_width,
+          "scene.hedge_offset", "hedge_offset >= 0, hedge_depth >= 0.1 m, both within the sidewalk");
 }
 
 bool intersect_object(const SceneObject& ob, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
@@ -251,6 +255,58 @@ bool intersect_object(const SceneObject& ob, const Eigen::Vector3d& origin, cons
     }
   }
   return hit;
+}
+
+SurfacePoint object_surface(const SceneObject& ob, double ground_y, std::uint8_t face, const Eigen::Vector3d& p) {
+  SurfacePoint s;
+  s.kind = ob.kind;
+  s.seed = ob.seed;
+  s.face = face;
+  const double rx = p.x() - ob.cx, rz = p.z() - ob.cz;
+  const double height = ground_y - p.y();
+  const double top = ground_y - (ob.cy - ob.hy);
+  if (ob.shape == SceneObject::Shape::sphere) {
+    const Eigen::Vector3d n = (p - Eigen::Vector3d(ob.cx, ob.cy, ob.cz)) / ob.hx;
+    s.u = (std::atan2(rz, rx) + std::numbers::pi) * ob.hx;
+    s.v = height;
+    s.extent_u = 2.0 * std::numbers::pi * ob.hx;
+    s.extent_v = top;
+    s.normal = n;
+    return s;
+  }
+  if (ob.shape == SceneObject::Shape::cylinder) {
+    if (face == 0) {
+      s.u = (std::atan2(rz, rx) + std::numbers::pi) * ob.hx;
+      s.v = height;
+      s.extent_u = 2.0 * std::numbers::pi * ob.hx;
+      s.extent_v = top;
+      s.normal = Eigen::Vector3d(rx, 0.0, rz).normalized();
+    } else {
+      s.u = rx + ob.hx;
+      s.v = rz + ob.hx;
+      s.extent_u = s.extent_v = 2.0 * ob.hx;
+      s.normal = -Eigen::Vector3d::UnitY();
+    }
+    return s;
+  }
+  const double lx = rx * ob.ax + rz * ob.az, lz = -rx * ob.az + rz * ob.ax;
+  const Eigen::Vector3d axis_x(ob.ax, 0.0, ob.az), axis_z(-ob.az, 0.0, ob.ax);
+  s.extent_v = top;
+  switch (face) {
+    case 0: s.u = ob.hz - lz; s.v = height; s.extent_u = 2.0 * ob.hz; s.normal = axis_x; break;
+    case 1: s.u = ob.hz + lz; s.v = height; s.extent_u = 2.0 * ob.hz; s.normal = -axis_x; break;
+    case 2:
+    case 3:
+      s.u = ob.hx + lx;
+      s.v = ob.hz + lz;
+      s.extent_u = 2.0 * ob.hx;
+      s.extent_v = 2.0 * ob.hz;
+      s.normal = face == 2 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d(-Eigen::Vector3d::UnitY());
+      break;
+    case 4: s.u = ob.hx + lx; s.v = height; s.extent_u = 2.0 * ob.hx; s.normal = axis_z; break;
+    default: s.u = ob.hx - lx; s.v = height; s.extent_u = 2.0 * ob.hx; s.normal = -axis_z; break;
+  }
+  return s;
 }
 
 bool GroundDecal::contains(double x, double z) const {
@@ -368,6 +424,7 @@ StreetScene::StreetScene(const DrivePath& path, const StreetOptions& options, st
       const PathPoint p = path.at(s + 0.5 * slot);
       s += slot;
       if (!taken) continue;
+      if (container && side == 0 && o.hedge_height > 0.0) continue;  // the hedge stands there
       const double lat = container ? kerb[side] + side_sign[side] * (0.3 + 0.5 * width)
                                    : kerb[side] - side_sign[side] * (0.15 + 0.5 * width);
       const Eigen::Vector2d c = Eigen::Vector2d(p.x, p.z) + lat * p.right();
@@ -397,6 +454,7 @@ StreetScene::StreetScene(const DrivePath& path, const StreetOptions& options, st
       const double radius = rng.uniform(0.06, 0.14), height = rng.uniform(3.5, 8.0);
       const bool sign = rng.uniform() < 0.45;
       const std::uint32_t pseed = rng.next32();
+      if (side == 0 && o.hedge_height > 0.0) continue;
       const Eigen::Vector2d c = Eigen::Vector2d(p.x, p.z) + (kerb[side] + side_sign[side] * 0.45) * p.right();
       const SceneObject pole = cylinder(SurfaceKind::pole, pseed, c, radius, ground_y_, height);
       if (clearance.distance(footprint(pole)) < o.road_half_width + 0.1) continue;
@@ -429,7 +487,8 @@ StreetScene::StreetScene(const DrivePath& path, const StreetOptions& options, st
       const PathPoint p = path.at(s);
       const double trunk_r = rng.uniform(0.12, 0.22), trunk_h = rng.uniform(2.6, 3.6), crown_r = rng.uniform(1.3, 2.3);
       const std::uint32_t tseed = rng.next32();
-      const Eigen::Vector2d c = Eigen::Vector2d(p.x, p.z) + (kerb[side] + side_sign[side] * 1.3) * p.right();
+      if (side == 0 && o.hedge_height > 0.0) continue;
+      const Eigen::Vector2d c = Eigen::Vector2d(p.x, p.z) + (kerb[side] + side_sign[side] * o.tree_offset) * p.right();
       const SceneObject trunk = cylinder(SurfaceKind::bark, tseed, c, trunk_r, ground_y_, trunk_h + 0.5 * crown_r);
       if (clearance.distance(footprint(trunk)) < o.road_half_width + 0.5) continue;
       SceneObject crown;
@@ -444,6 +503,23 @@ StreetScene::StreetScene(const DrivePath& path, const StreetOptions& options, st
       if (clearance.distance(footprint(crown)) < lane_clear) continue;
       objects_.push_back(trunk);
       objects_.push_back(crown);
+    }
+  }
+  // The hedge: pieces of 2.5-4.5 m along the right kerb, each of its own height, so that its top edge
+  // is ragged; its own random source keeps the rest of the street as without it.
+  if (o.hedge_height > 0.0) {
+    Rng hedge_rng(seed ^ 0x4ED6EULL);
+    const double near = kerb[0] + o.hedge_offset, mid = near + 0.5 * o.hedge_depth;
+    for (double s = s_begin - 10.0; s < s_end + 10.0;) {
+      const double len = hedge_rng.uniform(2.5, 4.5);
+      const double height = o.hedge_height * hedge_rng.uniform(0.85, 1.15);
+      const std::uint32_t hseed = hedge_rng.next32();
+      const Eigen::Vector2d a = path.point(s, mid), b = path.point(s + len, mid);
+      s += len;
+      const Eigen::Vector2d chord = b - a;
+      // overlap the neighbours a little so that no gap opens in bends
+      objects_.push_back(upright_box(SurfaceKind::foliage, hseed, 0.5 * (a + b), chord.normalized(),
+                                     0.5 * chord.norm() + 0.05, 0.5 * o.hedge_depth, ground_y_, 0.0, height));
     }
   }
   build_grid();
@@ -629,55 +705,7 @@ SurfacePoint StreetScene::surface(const RayHit& hit, const Eigen::Vector3d& orig
     s.normal = -Eigen::Vector3d::UnitY();
     return s;
   }
-  const SceneObject& ob = objects_[hit.object];
-  s.kind = ob.kind;
-  s.seed = ob.seed;
-  s.face = hit.face;
-  const double rx = p.x() - ob.cx, rz = p.z() - ob.cz;
-  const double height = ground_y_ - p.y();
-  const double top = ground_y_ - (ob.cy - ob.hy);
-  if (ob.shape == SceneObject::Shape::sphere) {
-    const Eigen::Vector3d n = (p - Eigen::Vector3d(ob.cx, ob.cy, ob.cz)) / ob.hx;
-    s.u = (std::atan2(rz, rx) + std::numbers::pi) * ob.hx;
-    s.v = height;
-    s.extent_u = 2.0 * std::numbers::pi * ob.hx;
-    s.extent_v = top;
-    s.normal = n;
-    return s;
-  }
-  if (ob.shape == SceneObject::Shape::cylinder) {
-    if (hit.face == 0) {
-      s.u = (std::atan2(rz, rx) + std::numbers::pi) * ob.hx;
-      s.v = height;
-      s.extent_u = 2.0 * std::numbers::pi * ob.hx;
-      s.extent_v = top;
-      s.normal = Eigen::Vector3d(rx, 0.0, rz).normalized();
-    } else {
-      s.u = rx + ob.hx;
-      s.v = rz + ob.hx;
-      s.extent_u = s.extent_v = 2.0 * ob.hx;
-      s.normal = -Eigen::Vector3d::UnitY();
-    }
-    return s;
-  }
-  const double lx = rx * ob.ax + rz * ob.az, lz = -rx * ob.az + rz * ob.ax;
-  const Eigen::Vector3d axis_x(ob.ax, 0.0, ob.az), axis_z(-ob.az, 0.0, ob.ax);
-  s.extent_v = top;
-  switch (hit.face) {
-    case 0: s.u = ob.hz - lz; s.v = height; s.extent_u = 2.0 * ob.hz; s.normal = axis_x; break;
-    case 1: s.u = ob.hz + lz; s.v = height; s.extent_u = 2.0 * ob.hz; s.normal = -axis_x; break;
-    case 2:
-    case 3:
-      s.u = ob.hx + lx;
-      s.v = ob.hz + lz;
-      s.extent_u = 2.0 * ob.hx;
-      s.extent_v = 2.0 * ob.hz;
-      s.normal = hit.face == 2 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d(-Eigen::Vector3d::UnitY());
-      break;
-    case 4: s.u = ob.hx + lx; s.v = height; s.extent_u = 2.0 * ob.hx; s.normal = axis_z; break;
-    default: s.u = ob.hx - lx; s.v = height; s.extent_u = 2.0 * ob.hx; s.normal = -axis_z; break;
-  }
-  return s;
+  return object_surface(objects_[hit.object], ground_y_, hit.face, p);
 }
 
 double StreetScene::signed_distance(const Eigen::Vector3d& p) const {

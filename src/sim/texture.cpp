@@ -399,4 +399,14 @@ Rgb albedo(const SurfacePoint& s, double footprint) {
   return grey(0.5F);
 }
 
+bool leaf_gap(const Eigen::Vector3d& p, double share) {
+  // two lattices on slanted planes so that the blobs are not aligned with the street
+  const float n = 0.65F * value_noise(p.x() + 0.6 * p.y(), p.z() - 0.4 * p.y(), 1.0 / 0.45, 707U) +
+                  0.35F * value_noise(p.x() - 0.3 * p.y(), p.z() + 0.7 * p.y(), 1.0 / 0.17, 708U);
+  // two octaves of value noise cluster around 0.5: a linear map of the share onto the threshold is
+  // close enough (measured: 0.2, 0.35, 0.5 give about 21, 34, 49 % of gaps)
+  const float threshold = 0.5F + 0.45F * (0.5F - static_cast<float>(std::clamp(share, 0.0, 1.0)));
+  return n > threshold;
+}
+
 }  // namespace rgbl::sim_detail

@@ -14,4 +14,8 @@ struct Rgb {
 // gives the surface's plain colour (the "untextured" look).
 Rgb albedo(const SurfacePoint& s, double footprint);
 
+// Whether sunlight passes a tree's crown at world point p: blobs of leaf gaps covering about `share`
+// of the crown (a function of the point alone, so the dapples stay put from frame to frame).
+bool leaf_gap(const Eigen::Vector3d& p, double share);
+
 }  // namespace rgbl::sim_detail

@@ -19,10 +19,11 @@ enum class PathKind {
   straight,  // one straight street
   curve,     // straights joined by bends, alternately left and right
   loop,      // a rounded square of left turns, from halfway along a side back to exactly the start
+  turn,      // a straight, one bend (a junction's 90 degree turn), then straight on
 };
 
 std::string_view to_string(PathKind kind);
-// "straight", "curve" or "loop"; nullopt for anything else.
+// "straight", "curve", "loop" or "turn"; nullopt for anything else.
 std::optional<PathKind> parse_path_kind(std::string_view name);
 
 struct PathOptions {
@@ -31,6 +32,9 @@ struct PathOptions {
   double bend_angle_deg = 60.0;     // turn of each bend of "curve"
   double bend_straight = 30.0;      // m of straight before each bend of "curve"
   double loop_corner_radius = 15.0; // m, radius of the four corners of "loop"
+  double turn_start = 20.0;         // m of straight before the bend of "turn"
+  double turn_radius = 12.0;        // m, radius of the bend of "turn" (of the camera's track)
+  double turn_angle_deg = 90.0;     // > 0 turns left, < 0 right
 
   void validate() const;
 };
@@ -48,6 +52,30 @@ struct PathPoint {
 
   Eigen::Vector2d forward() const;  // (x, z) of the driving direction
   Eigen::Vector2d right() const;    // (x, z) of the camera's +x axis
+};
+
+// Speed over time as phases of constant acceleration after an initial speed; after the last phase the
+// speed stays. A vehicle that brakes to 0 stands exactly still (its distance does not change by a bit).
+struct SpeedPhase {
+  double duration = 0.0;      // s
+  double acceleration = 0.0;  // m/s^2, < 0 brakes
+};
+
+class SpeedProfile {
+ public:
+  // Throws ConfigError naming `key` when the speed would become negative or a phase is not finite.
+  explicit SpeedProfile(double initial_speed = 10.0, std::vector<SpeedPhase> phases = {},
+                        const char* key = "speed_phases");
+
+  double speed(double t) const;     // m/s at time t >= 0
+  double distance(double t) const;  // m driven in [0, t]
+
+ private:
+  struct Knot {
+    double t, speed, distance;  // at the start of a phase
+    double acceleration;
+  };
+  std::vector<Knot> knots_;  // the last one holds the final speed with zero acceleration
 };
 
 class DrivePath {

@@ -32,6 +32,11 @@ struct StreetOptions {
   double container_probability = 0.12; // share of the taken slots holding a container
   double pole_spacing = 16.0;     // m, mean distance between poles along each kerb
   double tree_spacing = 14.0;     // m, mean distance between trees along each sidewalk
+  double tree_offset = 1.3;       // m, kerb to the trunks (crowns that would reach the driving lanes are left out)
+  // A dense hedge along the right kerb instead of poles, trees and bins on that sidewalk (0 = none).
+  double hedge_height = 0.0;      // m, mean height (it varies by +-15 % from piece to piece)
+  double hedge_offset = 0.3;      // m, kerb to the hedge's road-side face
+  double hedge_depth = 1.2;       // m
 
   void validate() const;
 };
@@ -75,6 +80,10 @@ struct GroundDecal {
 
   bool contains(double x, double z) const;
 };
+
+// Surface coordinates and outward normal of a hit on one object (not the ground) at world point p;
+// the road is the plane y = ground_y.
+SurfacePoint object_surface(const SceneObject& object, double ground_y, std::uint8_t face, const Eigen::Vector3d& p);
 
 // Ray origin + t * direction against one object: when it hits at t_min < t < t_best, sets t_best and
 // face and returns true.
