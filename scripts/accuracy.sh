@@ -7,6 +7,9 @@
 #   scripts/accuracy.sh [--build DIR] [--out DIR] [--seeds "1 2 3"] [--frames N] [--scenarios "a b"]
 #                       [--baseline FILE] [--save-baseline FILE] [--no-real] [--no-sim] [-- ARGS for rgbl run]
 #
+# Each scenario runs at its default length (`rgbl demo --scenario list`) unless --frames is given; the
+# plain street runs at every length used (`plain@<frames>-s<seed>`), so each scenario's ATE is compared
+# with the plain street's at the same frame count and seed.
 # Data: $RGBL_DATA, else ../shared/data next to the repository. Generated scenarios are cached in
 # $RGBL_CACHE (default ~/.cache/rgbl/scenarios), keyed by the simulator's sources, so a rerun after a
 # tracker change only tracks.
@@ -16,7 +19,7 @@ repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="$repo/build/release"
 out="$repo/build/accuracy"
 seeds="1 2 3"
-frames=80
+frames=""   # empty: each scenario at its own default length
 scenarios=""
 baseline="$repo/docs/accuracy-baseline.json"
 save=""
@@ -80,20 +83,40 @@ if [ "$real" = 1 ]; then
 fi
 
 if [ "$sim" = 1 ]; then
-  [ -n "$scenarios" ] || scenarios="$("$rgbl" demo --scenario list | awk 'NF && $1 !~ /:$/ {print $1}')"
+  listing="$("$rgbl" demo --scenario list)"
+  [ -n "$scenarios" ] || scenarios="$(awk 'NF && $1 !~ /:$/ {print $1}' <<< "$listing")"
+  scenarios="$(echo $scenarios)"   # one line, single spaces
+  length_of() {  # a scenario's frame count: --frames, else its default from the listing
+    if [ -n "$frames" ]; then echo "$frames"; return; fi
+    awk -v s="$1" '$1 == s { if (match($0, /default [0-9]+ frames/)) print substr($0, RSTART + 8, RLENGTH - 15) }' <<< "$listing"
+  }
   key="$(cat "$repo"/src/sim/* "$repo"/include/rgbl/sim/* "$repo"/apps/rgbl/demo_command.cpp | sha1sum | cut -c1-12)"
-  echo "scenarios ($frames frames, seeds $seeds; cache $cache, key $key):"
+  echo "scenarios (seeds $seeds; cache $cache, key $key):"
+  runs=()   # "name scenario frames"
+  plain_default="$(length_of plain)"
+  lengths=""
   for s in $scenarios; do
+    n="$(length_of "$s")"
+    [ -n "$n" ] || { echo "accuracy.sh: no default length for scenario '$s'" >&2; exit 1; }
+    runs+=("$s $s $n")
+    lengths="$lengths $n"
+  done
+  for n in $(tr ' ' '\n' <<< "$lengths" | sort -un); do
+    [ "$n" = "$plain_default" ] && [[ " $scenarios " == *" plain "* ]] && continue
+    runs+=("plain@$n plain $n")
+  done
+  for run in "${runs[@]}"; do
+    read -r name s n <<< "$run"
     for seed in $seeds; do
-      dir="$cache/$s-s$seed-f$frames-$key"
+      dir="$cache/$s-s$seed-f$n-$key"
       if [ ! -f "$dir/.complete" ]; then
         rm -rf "$dir"
-        echo "== generate $s seed $seed" >> "$log"
-        "$rgbl" -q demo --scenario "$s" --seed "$seed" --frames "$frames" --keep "$dir" --out "$out/gen-$s-$seed" \
-          >> "$log" 2>&1 && touch "$dir/.complete" || { printf '  %-28s generation FAILED\n' "$s-s$seed"; continue; }
+        echo "== generate $s seed $seed, $n frames" >> "$log"
+        "$rgbl" -q demo --scenario "$s" --seed "$seed" --frames "$n" --keep "$dir" --out "$out/gen-$s-$seed" \
+          >> "$log" 2>&1 && touch "$dir/.complete" || { printf '  %-28s generation FAILED\n' "$name-s$seed"; continue; }
         rm -rf "$out/gen-$s-$seed"
       fi
-      track "$s-s$seed" run "$dir/sequences/00" "${extra[@]}"
+      track "$name-s$seed" run "$dir/sequences/00" "${extra[@]}"
     done
   done
 fi

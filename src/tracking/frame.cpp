@@ -33,6 +33,13 @@ void TrackerOptions::validate() const {
   require(ransac_prior_relative >= 0.0, "tracker.ransac_prior_relative", ">= 0");
   require(ransac_prior_rotation_deg >= 0.0 && ransac_prior_rotation_deg <= 180.0, "tracker.ransac_prior_rotation_deg",
           "in [0, 180] degrees");
+  require(motion_gate_factor >= 0.0, "tracker.motion_gate_factor", ">= 0 (0 = off)");
+  require(moving_label_radius >= 0.0, "tracker.moving_label_radius", ">= 0 px (0 = seeds only)");
+  require(ground_min_height >= 0.0, "tracker.ground_min_height", ">= 0 m");
+  require(ground_max_tilt_deg >= 0.0 && ground_max_tilt_deg < 90.0, "tracker.ground_max_tilt_deg", "in [0, 90) degrees");
+  require(ground_tolerance > 0.0, "tracker.ground_tolerance", "> 0 m");
+  require(ground_min_points >= 3, "tracker.ground_min_points", ">= 3 (a plane needs 3 points)");
+  require(ground_iterations >= 1, "tracker.ground_iterations", ">= 1");
   require(min_ok_inliers >= min_pose_inliers, "tracker.min_ok_inliers", ">= tracker.min_pose_inliers");
   require(min_ok_inliers_after_relocalisation >= min_ok_inliers, "tracker.min_ok_inliers_after_relocalisation",
           ">= tracker.min_ok_inliers");

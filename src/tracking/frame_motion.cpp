@@ -11,9 +11,65 @@
 #include <numbers>
 #include <random>
 #include <span>
+#include <limits>
+#include <tuple>
 #include <vector>
 
 namespace rgbl {
+
+namespace {
+
+// Marks the points (camera frame, y down) on the dominant ground plane: a plane below the camera by at
+// least ground_min_height whose normal is within ground_max_tilt_deg of the camera's vertical, fitted by
+// a fixed-seed RANSAC. Empty when no such plane holds ground_min_points points.
+std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const TrackerOptions& options) {
+  std::vector<bool> ground;
+  std::vector<int> below;
+  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+    if (points[static_cast<std::size_t>(i)].y() >= options.ground_min_height) below.push_back(i);
+  }
+  if (static_cast<int>(below.size()) < options.ground_min_points) return ground;
+  const double cos_tilt = std::cos(options.ground_max_tilt_deg * std::numbers::pi / 180.0);
+  auto tolerance = [&](const Eigen::Vector3d& p) {
+    return std::max(options.ground_tolerance, options.ransac_relative_tolerance * p.z());
+  };
+  std::mt19937 rng(11);  // fixed seed: deterministic
+  std::uniform_int_distribution<std::size_t> pick(0, below.size() - 1);
+  int best_count = 0;
+  Eigen::Vector3d best_n = Eigen::Vector3d::Zero();
+  double best_d = 0.0;
+  for (int it = 0; it < options.ground_iterations; ++it) {
+    const Eigen::Vector3d& a = points[static_cast<std::size_t>(below[pick(rng)])];
+    const Eigen::Vector3d& b = points[static_cast<std::size_t>(below[pick(rng)])];
+    const Eigen::Vector3d& c = points[static_cast<std::size_t>(below[pick(rng)])];
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    if (n.norm() < 1e-6) continue;
+    n.normalize();
+    if (n.y() < 0.0) n = -n;  // pointing down, as the camera's y
+    if (n.y() < cos_tilt) continue;
+    const double d = n.dot(a);  // the camera's height above the plane
+    if (d < options.ground_min_height) continue;
+    int count = 0;
+    for (const int i : below) {
+      const Eigen::Vector3d& p = points[static_cast<std::size_t>(i)];
+      count += std::abs(n.dot(p) - d) < tolerance(p) ? 1 : 0;
+    }
+    if (count > best_count) {
+      best_count = count;
+      best_n = n;
+      best_d = d;
+    }
+  }
+  if (best_count < options.ground_min_points) return ground;
+  ground.assign(points.size(), false);
+  for (const int i : below) {
+    const Eigen::Vector3d& p = points[static_cast<std::size_t>(i)];
+    ground[static_cast<std::size_t>(i)] = std::abs(best_n.dot(p) - best_d) < tolerance(p);
+  }
+  return ground;
+}
+
+}  // namespace
 
 // Why: breaks the feedback of the constant-velocity prediction on periodic or weak texture (fences,
 // grass), where guided matching around a slightly wrong prediction finds matches that confirm it; the
@@ -21,10 +77,12 @@ namespace rgbl {
 // over when its corners outnumber the static scene's.
 std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& camera, const Frame& last, const Frame& frame,
                                                        const TrackerOptions& options,
-                                                       const std::optional<Eigen::Isometry3d>& prior) {
+                                                       const std::optional<Eigen::Isometry3d>& prior,
+                                                       std::vector<bool>* moving) {
   std::vector<Descriptor> last_desc, cur_desc;
   std::vector<Eigen::Vector3d> last_pts, cur_pts;
   std::vector<int> cur_cell;  // coverage cell of each current point
+  std::vector<std::size_t> cur_keypoint;  // keypoint index of each current point
   for (std::size_t i = 0; i < last.size(); ++i) {
     if (last.depth_sigma[i] <= 0.0F) continue;
     last_desc.push_back(last.descriptors[i]);
@@ -53,8 +111,12 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     cur_desc.push_back(frame.descriptors[i]);
     cur_pts.push_back(camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y), frame.depth[i]));
     cur_cell.push_back(cell_of(frame.keypoints[i]));
+    cur_keypoint.push_back(i);
   }
   const auto matches = detail::match_brute_force(cur_desc, last_desc, options.ransac_max_hamming, options.ransac_ratio);
+  // The road does not move: a consensus is ranked by the ground cells it covers before all others, so
+  // a truck alongside at the ego speed, however much of the image it fills, cannot win over the scene.
+  const std::vector<bool> ground = options.ransac_ground_first ? ground_points(cur_pts, options) : std::vector<bool>{};
   const int n = static_cast<int>(matches.size());
   if (n < options.ransac_min_inliers) return std::nullopt;
   auto fit = [&](std::span<const int> idx) {
@@ -84,14 +146,68 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
       inliers_of(T, consensus);
     }
   };
-  std::vector<int> cell_marks;
+  using Score = std::tuple<long, long, std::size_t>;  // ground cells, cells, points
+  std::vector<int> cell_marks, ground_marks;
   auto score_of = [&](const std::vector<int>& consensus) {
-    if (!by_coverage) return std::pair<long, std::size_t>(0L, consensus.size());
+    if (!by_coverage) return Score(0L, 0L, consensus.size());
     cell_marks.clear();
-    for (const int m : consensus) cell_marks.push_back(cur_cell[static_cast<std::size_t>(matches[static_cast<std::size_t>(m)].first)]);
-    std::sort(cell_marks.begin(), cell_marks.end());
-    const auto cells = std::unique(cell_marks.begin(), cell_marks.end()) - cell_marks.begin();
-    return std::pair<long, std::size_t>(static_cast<long>(cells), consensus.size());
+    ground_marks.clear();
+    for (const int m : consensus) {
+      const auto q = static_cast<std::size_t>(matches[static_cast<std::size_t>(m)].first);
+      cell_marks.push_back(cur_cell[q]);
+      if (!ground.empty() && ground[q]) ground_marks.push_back(cur_cell[q]);
+    }
+    const auto distinct = [](std::vector<int>& v) {
+      std::sort(v.begin(), v.end());
+      return static_cast<long>(std::unique(v.begin(), v.end()) - v.begin());
+    };
+    return Score(distinct(ground_marks), distinct(cell_marks), consensus.size());
+  };
+  // Seeds: matched points that agree with T (static) or lie beyond motion_gate_factor tolerances
+  // (moving); other keypoints with depth take the label of the nearest seed within
+  // moving_label_radius px at a continuous depth (one rigid surface).
+  auto label_moving = [&](const Eigen::Isometry3d& T) {
+    moving->assign(frame.size(), false);
+    if (options.motion_gate_factor <= 0.0 || options.moving_label_radius <= 0.0) return;
+    std::vector<signed char> seed(frame.size(), -1);  // -1 none, 0 static, 1 moving
+    for (int m = 0; m < n; ++m) {
+      const auto& [q, t] = matches[static_cast<std::size_t>(m)];
+      const Eigen::Vector3d& pc = cur_pts[static_cast<std::size_t>(q)];
+      const double tolerance = std::max(options.ransac_min_tolerance, options.ransac_relative_tolerance * pc.z());
+      const double error = (T * last_pts[static_cast<std::size_t>(t)] - pc).norm();
+      const std::size_t k = cur_keypoint[static_cast<std::size_t>(q)];
+      if (error < tolerance) seed[k] = 0;
+      else if (error > options.motion_gate_factor * tolerance) seed[k] = 1;
+    }
+    std::vector<int> near;
+    const auto radius = static_cast<float>(options.moving_label_radius);
+    const auto continuous = [&](std::size_t a, std::size_t b) {
+      const float gap = std::max(static_cast<float>(options.ransac_min_tolerance),
+                                 static_cast<float>(options.ransac_relative_tolerance) * frame.depth[a]);
+      return std::abs(frame.depth[a] - frame.depth[b]) <= gap;
+    };
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      if (seed[i] == 1) {
+        (*moving)[i] = true;
+        continue;
+      }
+      if (seed[i] == 0 || frame.depth_sigma[i] <= 0.0F) continue;
+      const Keypoint& kp = frame.keypoints[i];
+      frame.grid.query(kp.x, kp.y, radius, 0, -1, near);
+      float best = std::numeric_limits<float>::max();
+      signed char label = 0;
+      for (const int j : near) {
+        const auto sj = static_cast<std::size_t>(j);
+        if (seed[sj] < 0 || !continuous(i, sj)) continue;
+        const float dx = frame.keypoints[sj].x - kp.x, dy = frame.keypoints[sj].y - kp.y;
+        const float d2 = dx * dx + dy * dy;
+        if (d2 < best) {
+          best = d2;
+          label = seed[sj];
+        }
+      }
+      (*moving)[i] = label == 1;
+    }
   };
   const bool use_prior = prior.has_value();
   auto near_prior = [&](const Eigen::Isometry3d& T) {
@@ -104,7 +220,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
   std::mt19937 rng(7);  // fixed seed: deterministic
   std::uniform_int_distribution<int> pick(0, n - 1);
   std::vector<int> best, best_near, current;
-  std::pair<long, std::size_t> best_score{-1, 0}, near_score{-1, 0};
+  Score best_score{-1, -1, 0}, near_score{-1, -1, 0};
   Eigen::Isometry3d T_best = Eigen::Isometry3d::Identity(), T_near = Eigen::Isometry3d::Identity();
   if (use_prior) {
     // The prior itself, refined, is the first near hypothesis: sampling alone may miss the static
@@ -138,6 +254,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     if (best_near.empty()) return std::nullopt;
     refine(T_near, best_near);
     if (!near_prior(T_near) || static_cast<int>(best_near.size()) < options.ransac_min_inliers) return std::nullopt;
+    if (moving != nullptr) label_moving(T_near);
     if (!best.empty() && best.size() > best_near.size() && !near_prior(T_best)) {
       logger()->debug("frame {}: depth RANSAC keeps the motion near constant velocity ({} inliers) over another "
                       "({} inliers, {:.2f} m from it)", frame.index, best_near.size(), best.size(),
@@ -147,6 +264,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
   }
   refine(T_best, best);
   if (static_cast<int>(best.size()) < options.ransac_min_inliers) return std::nullopt;
+  if (moving != nullptr) label_moving(T_best);
   return T_best;
 }
 

@@ -22,6 +22,7 @@ int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates,
     int best = INT_MAX, second = INT_MAX, best_index = -1, best_level = -1, second_level = -1;
     for (const int k : cell) {
       if (frame.landmarks[static_cast<std::size_t>(k)].valid() && owner[static_cast<std::size_t>(k)] < 0) continue;
+      if (frame.is_moving(static_cast<std::size_t>(k))) continue;
       if (gate.sigmas > 0.0F && cand.depth > 0.0F && frame.depth[static_cast<std::size_t>(k)] > 0.0F) {
         const float gap = std::max(gate.min_gap, gate.sigmas * frame.depth_sigma[static_cast<std::size_t>(k)]);
         if (std::abs(frame.depth[static_cast<std::size_t>(k)] - cand.depth) > gap) continue;

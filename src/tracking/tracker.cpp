@@ -27,6 +27,10 @@ Keyframe keyframe_from(const Frame& frame) {
   kf.descriptors = frame.descriptors;
   kf.depth = frame.depth;
   kf.depth_sigma = frame.depth_sigma;
+  // a point on a moving object is no landmark: without usable depth, local mapping makes none from it
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.is_moving(i)) kf.depth_sigma[i] = 0.0F;
+  }
   return kf;
 }
 
@@ -44,6 +48,7 @@ double level_scale(const Map& map, int level) { return std::pow(map.options().sc
 void clear_matches(Frame& frame) {
   std::fill(frame.landmarks.begin(), frame.landmarks.end(), LandmarkId{});
   std::fill(frame.outlier.begin(), frame.outlier.end(), false);
+  frame.moving.clear();  // labels belong to the motion hypothesis being discarded
 }
 
 void discard_outliers(Frame& frame) {
@@ -62,6 +67,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   const TrackState previous_state = state_;
   frame.landmarks.assign(frame.size(), LandmarkId{});
   frame.outlier.assign(frame.size(), false);
+  frame.moving.clear();
   auto count_tracked = [](const Frame& f) {
     return static_cast<int>(std::count_if(f.landmarks.begin(), f.landmarks.end(), [](LandmarkId l) { return l.valid(); }));
   };
@@ -336,9 +342,11 @@ int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t
 int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const Eigen::Isometry3d& T_guess,
                                      const std::optional<Eigen::Isometry3d>& prior) {
   frame.T_cam_world = T_guess;
+  bool from_consensus = false;
   if (options_.ransac_prediction) {
-    if (const auto T_cur_last = estimate_frame_motion(camera_, reference, frame, options_, prior)) {
+    if (const auto T_cur_last = estimate_frame_motion(camera_, reference, frame, options_, prior, &frame.moving)) {
       frame.T_cam_world = *T_cur_last * reference.T_cam_world;
+      from_consensus = true;
     }
   }
   std::vector<detail::ProjectedLandmark> candidates;
@@ -354,7 +362,7 @@ int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const
       const Landmark* l = landmark ? map_.landmark(last.landmarks[i]) : nullptr;
       // Keypoints of the last frame with depth but no landmark become temporary points (ORB-SLAM's
       // visual-odometry points): they anchor frame-to-frame motion where the map is thin.
-      const bool temporary = l == nullptr && last.depth_sigma[i] > 0.0F && options_.temporary_points;
+      const bool temporary = l == nullptr && last.depth_sigma[i] > 0.0F && options_.temporary_points && !last.is_moving(i);
       if (l == nullptr && !temporary) continue;
       const Eigen::Vector3d p_world =
           l != nullptr ? l->position
@@ -392,11 +400,22 @@ int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const
                                       &candidate_of_keypoint, gate);
   }
   if (matches < options_.motion_min_matches) return 0;
+  // The depth consensus predicts the pose well: matches far from it are on objects moving against the
+  // scene and are left out of the pose (the constant-velocity guess alone is not trusted that far).
+  // Without a consensus, a trusted constant velocity predicts the pose to within a vehicle's reach
+  // (the step check's tolerance), which widens the gate by as much.
+  const bool moving_gate = (from_consensus || prior) && options_.motion_gate_factor > 0.0;
+  const double slack = from_consensus || !prior ? 0.0
+                                                : options_.step_tolerance +
+                                                      options_.step_tolerance_relative * prior->translation().norm() +
+                                                      0.5 * options_.max_acceleration * velocity_dt_ * velocity_dt_;
+  if (moving_gate) drop_moving_matches(frame, slack);
   std::vector<std::pair<std::size_t, Eigen::Vector3d>> extra;
   for (std::size_t k = 0; k < frame.size(); ++k) {
     const int c = candidate_of_keypoint[k];
     if (c >= 0 && !candidates[static_cast<std::size_t>(c)].id.valid()) {
-      extra.emplace_back(k, candidate_points[static_cast<std::size_t>(c)]);
+      const Eigen::Vector3d& p_world = candidate_points[static_cast<std::size_t>(c)];
+      if (!moving_gate || !disagrees_with_pose(frame, k, p_world, slack)) extra.emplace_back(k, p_world);
     }
   }
   const int inliers = optimise_pose(frame, extra);
@@ -428,13 +447,46 @@ bool Tracker::track_reference_keyframe(Frame& frame) {
   if (last_frame_ && options_.ransac_prediction) {
     TrackerOptions guess_options = options_;  // a guess only: the optimisation below decides
     guess_options.ransac_min_inliers = options_.ransac_guess_min_inliers;
-    if (const auto T_cur_last = estimate_frame_motion(camera_, *last_frame_, frame, guess_options, trusted_velocity())) {
+    if (const auto T_cur_last =
+            estimate_frame_motion(camera_, *last_frame_, frame, guess_options, trusted_velocity(), &frame.moving)) {
       frame.T_cam_world = *T_cur_last * last_frame_->T_cam_world;
+      // Descriptor matches carry no geometry: those whose 3-D point disagrees with the static
+      // consensus are objects moving against the scene (or aliasing), not evidence for the pose.
+      drop_moving_matches(frame);
     }
   }
   const int inliers = optimise_pose(frame);
   discard_outliers(frame);
   return inliers >= options_.min_pose_inliers;
+}
+
+bool Tracker::disagrees_with_pose(const Frame& frame, std::size_t i, const Eigen::Vector3d& p_world, double slack) const {
+  const Keypoint& kp = frame.keypoints[i];
+  const Eigen::Vector3d predicted = frame.T_cam_world * p_world;
+  if (predicted.z() <= 0.0) return true;
+  if (frame.depth_sigma[i] > 0.0F) {
+    const Eigen::Vector3d measured = camera_.unproject(Eigen::Vector2d(kp.x, kp.y), frame.depth[i]);
+    const double tolerance = slack + options_.motion_gate_factor * std::max(options_.ransac_min_tolerance,
+                                                                             options_.ransac_relative_tolerance * measured.z());
+    return (predicted - measured).norm() > tolerance;
+  }
+  // no depth (e.g. above the LiDAR's field of view): as far off as guided matching would search
+  const double radius = options_.motion_radius * level_scale(map_, kp.level);
+  return (camera_.project_unchecked(predicted) - Eigen::Vector2d(kp.x, kp.y)).norm() > radius;
+}
+
+int Tracker::drop_moving_matches(Frame& frame, double slack) const {
+  if (options_.motion_gate_factor <= 0.0) return 0;
+  int dropped = 0;
+  std::shared_lock lock(map_.mutex());
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (!frame.landmarks[i].valid()) continue;
+    const Landmark* l = map_.landmark(frame.landmarks[i]);
+    if (l == nullptr || (!frame.is_moving(i) && !disagrees_with_pose(frame, i, l->position, slack))) continue;
+    frame.landmarks[i] = LandmarkId{};
+    ++dropped;
+  }
+  return dropped;
 }
 
 void Tracker::update_local_map(const Frame& frame) {

@@ -125,3 +125,71 @@ TEST_CASE("frame motion: options are validated with their keys") {
   options.ransac_min_inliers = 2;
   CHECK_THROWS_WITH(options.validate(), Catch::Matchers::Contains("tracker.ransac_min_inliers"));
 }
+
+TEST_CASE("frame motion: a truck alongside at the camera's speed covers more of the image; the road decides") {
+  const rgbl::PinholeCamera cam = rgbl::test::kitti_camera();
+  std::mt19937 rng(5);
+  // The camera (1.65 m above the road, y down) drives 1.0 m forward. A truck's side 2.5 m to the right
+  // moves exactly with it and fills the right half of the image; the static scene is the road ahead
+  // and a few facades far on the left.
+  Eigen::Isometry3d T_true = Eigen::Isometry3d::Identity();
+  T_true.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);
+  Scene scene;
+  add_points(scene, rng, 40, {-3.0, 1.65, 6.0}, {1.5, 1.65, 25.0}, T_true);    // road
+  add_points(scene, rng, 12, {-9.0, -4.0, 25.0}, {-8.0, 1.0, 45.0}, T_true);   // facades
+  add_points(scene, rng, 160, {2.5, -2.6, 3.2}, {2.5, 1.3, 14.0}, Eigen::Isometry3d::Identity());  // truck side
+  auto [last, cur] = frames_of(scene, cam, rng);
+  cur.build_grid(cam.width, cam.height);
+  rgbl::TrackerOptions options;
+  rgbl::TrackerOptions coverage_only = options;
+  coverage_only.ransac_ground_first = false;
+
+  SECTION("ranked by image coverage alone, the truck wins (no motion)") {
+    const auto T = rgbl::estimate_frame_motion(cam, last, cur, coverage_only);
+    REQUIRE(T);
+    // the far facades agree with both motions (3 % of 45 m), so the consensus leans a little off zero
+    CHECK(translation_error(*T, Eigen::Isometry3d::Identity()) < 0.2);
+    CHECK(translation_error(*T, T_true) > 0.8);
+  }
+  SECTION("ground cells first: the scene's motion, exactly, and the truck's points labelled moving") {
+    std::vector<bool> moving;
+    const auto T = rgbl::estimate_frame_motion(cam, last, cur, options, std::nullopt, &moving);
+    REQUIRE(T);
+    CHECK(translation_error(*T, T_true) < 1e-3);
+    CHECK(rotation_error_deg(*T, T_true) < 1e-3);
+    REQUIRE(moving.size() == cur.size());
+    int truck = 0, truck_moving = 0, scene_moving = 0;
+    for (std::size_t i = 0; i < cur.size(); ++i) {
+      // the truck side is the only surface at x = 2.5 m
+      const bool on_truck = std::abs(cam.unproject({cur.keypoints[i].x, cur.keypoints[i].y}, cur.depth[i]).x() - 2.5) < 1e-3;
+      truck += on_truck ? 1 : 0;
+      truck_moving += on_truck && moving[i] ? 1 : 0;
+      scene_moving += !on_truck && moving[i] ? 1 : 0;
+    }
+    CHECK(truck == 160);
+    CHECK(truck_moving == truck);
+    CHECK(scene_moving == 0);
+  }
+  SECTION("without a road plane (too few points on it) coverage decides again") {
+    rgbl::TrackerOptions strict = options;
+    strict.ground_min_points = 60;
+    const auto T = rgbl::estimate_frame_motion(cam, last, cur, strict);
+    REQUIRE(T);
+    CHECK(translation_error(*T, T_true) > 0.8);
+  }
+}
+
+TEST_CASE("frame motion: ground and moving-object options are validated with their keys") {
+  rgbl::TrackerOptions options;
+  options.ground_max_tilt_deg = 95.0;
+  CHECK_THROWS_WITH(options.validate(), Catch::Matchers::Contains("tracker.ground_max_tilt_deg"));
+  options = {};
+  options.ground_min_points = 2;
+  CHECK_THROWS_WITH(options.validate(), Catch::Matchers::Contains("tracker.ground_min_points"));
+  options = {};
+  options.motion_gate_factor = -1.0;
+  CHECK_THROWS_WITH(options.validate(), Catch::Matchers::Contains("tracker.motion_gate_factor"));
+  options = {};
+  options.moving_label_radius = -1.0;
+  CHECK_THROWS_WITH(options.validate(), Catch::Matchers::Contains("tracker.moving_label_radius"));
+}

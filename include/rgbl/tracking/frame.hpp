@@ -30,10 +30,15 @@ struct Frame {
   std::vector<float> depth_sigma;  // metres, 0 = depth not usable
   std::vector<LandmarkId> landmarks;
   std::vector<bool> outlier;
+  // Keypoints on something moving against the scene: depth-consensus outliers of the frame-to-frame
+  // motion and their depth-continuous neighbours (estimate_frame_motion). Empty = none known. They
+  // are neither matched nor made landmarks.
+  std::vector<bool> moving;
   Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();
   FeatureGrid grid;  // radius queries over keypoints; rebuild after changing them
 
   std::size_t size() const { return keypoints.size(); }
+  bool is_moving(std::size_t i) const { return !moving.empty() && moving[i]; }
   void build_grid(int width, int height) { grid = FeatureGrid(keypoints, width, height); }
 };
 

@@ -23,8 +23,14 @@ namespace rgbl {
 // ransac_prior_rotation_deg. The prior itself, refined on its own consensus, is the first candidate,
 // so a static scene outnumbered by an object moving with the camera is still found.
 // nullopt: fewer than ransac_min_inliers agree (then the caller keeps its own prediction).
+//
+// With `moving` given and a motion found, it is set per keypoint of `frame`: matched points further
+// than motion_gate_factor tolerances from the motion, and keypoints with depth within
+// moving_label_radius px of such a point at a continuous depth (nearer to it than to a point that
+// agrees), are on something moving against the scene.
 std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& camera, const Frame& last, const Frame& frame,
                                                        const TrackerOptions& options,
-                                                       const std::optional<Eigen::Isometry3d>& prior = std::nullopt);
+                                                       const std::optional<Eigen::Isometry3d>& prior = std::nullopt,
+                                                       std::vector<bool>* moving = nullptr);
 
 }  // namespace rgbl

@@ -71,6 +71,24 @@ struct TrackerOptions {
   // object moving with the camera (a van ahead at the same speed) whose corners outnumber the static
   // scene's takes over the pose. A real jump in the input is left to the verification below.
   bool ransac_motion_prior = true;
+  // The road does not move: consensus is ranked by the coverage cells of its points on the ground
+  // plane first (a plane at least ground_min_height below the camera, normal within
+  // ground_max_tilt_deg of the camera's vertical, ground_min_points of the current frame's depth
+  // points within max(ground_tolerance, ransac_relative_tolerance * z)); without such a plane, by
+  // coverage alone. A truck alongside at the ego speed may fill half the image, never the road.
+  bool ransac_ground_first = true;
+  // Once that consensus predicts the pose, a keypoint whose landmark lies further than
+  // motion_gate_factor RANSAC tolerances from its measured 3-D point is not used for the pose: it is on
+  // something moving against the scene (0 = off).
+  double motion_gate_factor = 2.0;
+  // ...and keypoints with depth within moving_label_radius px of such a point, at a continuous depth,
+  // share its label (0 = only the RANSAC's own points are labelled).
+  double moving_label_radius = 24.0;       // px
+  double ground_min_height = 0.8;          // m below the camera
+  double ground_max_tilt_deg = 20.0;
+  double ground_tolerance = 0.1;           // m
+  int ground_min_points = 15;
+  int ground_iterations = 60;
   double ransac_prior_translation = 0.3;   // m
   double ransac_prior_relative = 0.25;
   double ransac_prior_rotation_deg = 3.0;
