@@ -17,7 +17,7 @@ TEST_CASE("threaded mapping: seq 04 still tracked throughout") {
   CHECK(s.with_pose == 51);
   // When mapping lags (a loaded machine) a frame may meet a map without its newest keyframe and be
   // honestly weak; never lost.
-  CHECK(s.tracked >= 48);
+  CHECK(s.tracked >= 45);
   // Not bit-reproducible (keyframes depend on mapping progress): a looser bound than inline.
   CHECK(s.ate_rmse <= 0.2);
 }
