@@ -8,10 +8,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <span>
-#include <limits>
 #include <tuple>
 #include <vector>
 
@@ -114,11 +114,12 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     cur_keypoint.push_back(i);
   }
   const auto matches = detail::match_brute_force(cur_desc, last_desc, options.ransac_max_hamming, options.ransac_ratio);
-  // The road does not move: a consensus is ranked by the ground cells it covers before all others, so
-  // a truck alongside at the ego speed, however much of the image it fills, cannot win over the scene.
-  const std::vector<bool> ground = options.ransac_ground_first ? ground_points(cur_pts, options) : std::vector<bool>{};
   const int n = static_cast<int>(matches.size());
   if (n < options.ransac_min_inliers) return std::nullopt;
+  // The road does not move: a consensus is ranked by the ground cells it covers before all others, so
+  // a truck alongside at the ego speed, however much of the image it fills, cannot win over the scene.
+  const std::vector<bool> ground =
+      by_coverage && options.ransac_ground_first ? ground_points(cur_pts, options) : std::vector<bool>{};
   auto fit = [&](std::span<const int> idx) {
     Eigen::Matrix3Xd a(3, static_cast<Eigen::Index>(idx.size())), b(3, static_cast<Eigen::Index>(idx.size()));
     for (std::size_t k = 0; k < idx.size(); ++k) {
@@ -135,8 +136,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     for (int m = 0; m < n; ++m) {
       const auto& [q, t] = matches[static_cast<std::size_t>(m)];
       const Eigen::Vector3d& pc = cur_pts[static_cast<std::size_t>(q)];
-      const double tolerance = std::max(options.ransac_min_tolerance, options.ransac_relative_tolerance * pc.z());
-      if ((T * last_pts[static_cast<std::size_t>(t)] - pc).norm() < tolerance) out.push_back(m);
+      if ((T * last_pts[static_cast<std::size_t>(t)] - pc).norm() < depth_tolerance(pc.z(), options)) out.push_back(m);
     }
   };
   // Refit on the consensus and recount (twice: the first fit may still lean on a few outliers).
@@ -173,7 +173,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     for (int m = 0; m < n; ++m) {
       const auto& [q, t] = matches[static_cast<std::size_t>(m)];
       const Eigen::Vector3d& pc = cur_pts[static_cast<std::size_t>(q)];
-      const double tolerance = std::max(options.ransac_min_tolerance, options.ransac_relative_tolerance * pc.z());
+      const double tolerance = depth_tolerance(pc.z(), options);
       const double error = (T * last_pts[static_cast<std::size_t>(t)] - pc).norm();
       const std::size_t k = cur_keypoint[static_cast<std::size_t>(q)];
       if (error < tolerance) seed[k] = 0;
@@ -182,9 +182,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     std::vector<int> near;
     const auto radius = static_cast<float>(options.moving_label_radius);
     const auto continuous = [&](std::size_t a, std::size_t b) {
-      const float gap = std::max(static_cast<float>(options.ransac_min_tolerance),
-                                 static_cast<float>(options.ransac_relative_tolerance) * frame.depth[a]);
-      return std::abs(frame.depth[a] - frame.depth[b]) <= gap;
+      return std::abs(frame.depth[a] - frame.depth[b]) <= depth_tolerance(frame.depth[a], options);
     };
     for (std::size_t i = 0; i < frame.size(); ++i) {
       if (seed[i] == 1) {

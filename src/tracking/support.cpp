@@ -24,6 +24,11 @@ TrackState support_state(int inliers, std::optional<std::size_t> frames_since_re
   return inliers >= needed ? TrackState::Ok : TrackState::Weak;
 }
 
+double allowed_step(double predicted_step_m, double dt, const TrackerOptions& options) {
+  const double acceleration_term = dt > 0.0 ? 0.5 * options.max_acceleration * dt * dt : 0.0;
+  return options.step_tolerance + options.step_tolerance_relative * std::max(0.0, predicted_step_m) + acceleration_term;
+}
+
 StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry3d& T_cam_world_predicted,
                      double predicted_step_m, double dt, const TrackerOptions& options) {
   StepCheck check;
@@ -32,9 +37,7 @@ StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry
   check.translation_m = (centre - predicted_centre).norm();
   const Eigen::AngleAxisd relative(T_cam_world.linear() * T_cam_world_predicted.linear().transpose());
   check.rotation_deg = std::abs(relative.angle()) * 180.0 / std::numbers::pi;
-  const double acceleration_term = dt > 0.0 ? 0.5 * options.max_acceleration * dt * dt : 0.0;
-  check.allowed_translation_m =
-      options.step_tolerance + options.step_tolerance_relative * std::max(0.0, predicted_step_m) + acceleration_term;
+  check.allowed_translation_m = allowed_step(predicted_step_m, dt, options);
   check.plausible = check.translation_m <= check.allowed_translation_m &&
                     check.rotation_deg <= options.step_tolerance_rotation_deg;
   return check;

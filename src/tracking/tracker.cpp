@@ -405,10 +405,7 @@ int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const
   // Without a consensus, a trusted constant velocity predicts the pose to within a vehicle's reach
   // (the step check's tolerance), which widens the gate by as much.
   const bool moving_gate = (from_consensus || prior) && options_.motion_gate_factor > 0.0;
-  const double slack = from_consensus || !prior ? 0.0
-                                                : options_.step_tolerance +
-                                                      options_.step_tolerance_relative * prior->translation().norm() +
-                                                      0.5 * options_.max_acceleration * velocity_dt_ * velocity_dt_;
+  const double slack = from_consensus || !prior ? 0.0 : allowed_step(prior->translation().norm(), velocity_dt_, options_);
   if (moving_gate) drop_moving_matches(frame, slack);
   std::vector<std::pair<std::size_t, Eigen::Vector3d>> extra;
   for (std::size_t k = 0; k < frame.size(); ++k) {
@@ -466,27 +463,22 @@ bool Tracker::disagrees_with_pose(const Frame& frame, std::size_t i, const Eigen
   if (predicted.z() <= 0.0) return true;
   if (frame.depth_sigma[i] > 0.0F) {
     const Eigen::Vector3d measured = camera_.unproject(Eigen::Vector2d(kp.x, kp.y), frame.depth[i]);
-    const double tolerance = slack + options_.motion_gate_factor * std::max(options_.ransac_min_tolerance,
-                                                                             options_.ransac_relative_tolerance * measured.z());
-    return (predicted - measured).norm() > tolerance;
+    return (predicted - measured).norm() > slack + options_.motion_gate_factor * depth_tolerance(measured.z(), options_);
   }
   // no depth (e.g. above the LiDAR's field of view): as far off as guided matching would search
   const double radius = options_.motion_radius * level_scale(map_, kp.level);
   return (camera_.project_unchecked(predicted) - Eigen::Vector2d(kp.x, kp.y)).norm() > radius;
 }
 
-int Tracker::drop_moving_matches(Frame& frame, double slack) const {
-  if (options_.motion_gate_factor <= 0.0) return 0;
-  int dropped = 0;
+void Tracker::drop_moving_matches(Frame& frame, double slack) const {
+  if (options_.motion_gate_factor <= 0.0) return;
   std::shared_lock lock(map_.mutex());
   for (std::size_t i = 0; i < frame.size(); ++i) {
     if (!frame.landmarks[i].valid()) continue;
     const Landmark* l = map_.landmark(frame.landmarks[i]);
     if (l == nullptr || (!frame.is_moving(i) && !disagrees_with_pose(frame, i, l->position, slack))) continue;
     frame.landmarks[i] = LandmarkId{};
-    ++dropped;
   }
-  return dropped;
 }
 
 void Tracker::update_local_map(const Frame& frame) {

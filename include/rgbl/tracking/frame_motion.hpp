@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <optional>
 
 namespace rgbl {
@@ -28,6 +29,12 @@ namespace rgbl {
 // than motion_gate_factor tolerances from the motion, and keypoints with depth within
 // moving_label_radius px of such a point at a continuous depth (nearer to it than to a point that
 // agrees), are on something moving against the scene.
+// How far a point at depth z may be from where a rigid motion puts it and still agree with it:
+// max(ransac_min_tolerance, ransac_relative_tolerance * z), LiDAR noise growing with range.
+inline double depth_tolerance(double z, const TrackerOptions& options) {
+  return std::max(options.ransac_min_tolerance, options.ransac_relative_tolerance * z);
+}
+
 std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& camera, const Frame& last, const Frame& frame,
                                                        const TrackerOptions& options,
                                                        const std::optional<Eigen::Isometry3d>& prior = std::nullopt,

@@ -30,6 +30,11 @@ constexpr bool has_pose(TrackState state) { return state == TrackState::Ok || st
 TrackState support_state(int inliers, std::optional<std::size_t> frames_since_relocalisation,
                          const TrackerOptions& options);
 
+// How far (m) a camera centre may end up from the constant-velocity prediction of a step of
+// predicted_step_m over dt seconds: step_tolerance + step_tolerance_relative * step + max_acceleration
+// * dt^2 / 2 (dt <= 0: unknown, the acceleration term left out).
+double allowed_step(double predicted_step_m, double dt, const TrackerOptions& options);
+
 // How far a pose is from the constant-velocity prediction, and whether that is within a vehicle's
 // reach in dt seconds.
 struct StepCheck {

@@ -61,10 +61,9 @@ class Tracker {
     return options_.ransac_motion_prior && velocity_steady_ ? velocity_ : std::nullopt;
   }
   bool track_reference_keyframe(Frame& frame);
-  // Unmatches keypoints with depth whose landmark, seen from frame.T_cam_world (a depth-consensus
-  // prediction), lies beyond slack + motion_gate_factor RANSAC tolerances of the measured point.
-  // Returns how many.
-  int drop_moving_matches(Frame& frame, double slack = 0.0) const;
+  // Unmatches keypoints labelled moving and those whose landmark disagrees with frame.T_cam_world (a
+  // depth-consensus prediction; see disagrees_with_pose).
+  void drop_moving_matches(Frame& frame, double slack = 0.0) const;
   // Keypoint i against world point p_world seen from frame.T_cam_world: in 3-D where it has depth
   // (beyond slack metres more than the gate), else beyond the guided-matching radius in the image.
   bool disagrees_with_pose(const Frame& frame, std::size_t i, const Eigen::Vector3d& p_world, double slack = 0.0) const;
