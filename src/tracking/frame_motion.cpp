@@ -30,8 +30,10 @@ std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const T
   }
   if (static_cast<int>(below.size()) < options.ground_min_points) return ground;
   const double cos_tilt = std::cos(options.ground_max_tilt_deg * std::numbers::pi / 180.0);
-  auto tolerance = [&](const Eigen::Vector3d& p) {
-    return std::max(options.ground_tolerance, options.ransac_relative_tolerance * p.z());
+  // A depth error lies along the viewing ray; the road is seen at a grazing angle, so only the ray's
+  // component along the plane normal moves a point off the plane (its depth error times n.p/|p|).
+  auto tolerance = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
+    return std::max(options.ground_tolerance, options.ransac_relative_tolerance * p.z() * std::abs(n.dot(p)) / p.norm());
   };
   std::mt19937 rng(11);  // fixed seed: deterministic
   std::uniform_int_distribution<std::size_t> pick(0, below.size() - 1);
@@ -52,7 +54,7 @@ std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const T
     int count = 0;
     for (const int i : below) {
       const Eigen::Vector3d& p = points[static_cast<std::size_t>(i)];
-      count += std::abs(n.dot(p) - d) < tolerance(p) ? 1 : 0;
+      count += std::abs(n.dot(p) - d) < tolerance(p, n) ? 1 : 0;
     }
     if (count > best_count) {
       best_count = count;
@@ -64,7 +66,7 @@ std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const T
   ground.assign(points.size(), false);
   for (const int i : below) {
     const Eigen::Vector3d& p = points[static_cast<std::size_t>(i)];
-    ground[static_cast<std::size_t>(i)] = std::abs(best_n.dot(p) - best_d) < tolerance(p);
+    ground[static_cast<std::size_t>(i)] = std::abs(best_n.dot(p) - best_d) < tolerance(p, best_n);
   }
   return ground;
 }
