@@ -13,7 +13,7 @@
 namespace rgbl::cli {
 namespace {
 
-// --depth: lidar | lidar:ipbasic | lidar:ipbasic-multiscale | lidar:<kernel><size> (e.g. lidar:diamond7)
+// --depth: lidar | lidar:dilated | lidar:ipbasic | lidar:ipbasic-multiscale | lidar:<kernel><size> (e.g. lidar:diamond7)
 // | precomputed:<dir> | stereo | stereo_sparse | rgbd
 void apply_depth_spec(const std::string& spec, Pipeline& p) {
   const auto colon = spec.find(':');
@@ -23,7 +23,9 @@ void apply_depth_spec(const std::string& spec, Pipeline& p) {
   auto& lidar = p.depth_settings.lidar;
   if (name == "lidar") {
     if (arg.empty() || arg == "dilation") return;
-    if (arg == "ipbasic" || arg == "ipbasic-fast") {
+    if (arg == "dilated") {
+      lidar.keypoint_depth = KeypointDepthRule::dilated;  // the paper's keypoint depth: the dense map's value
+    } else if (arg == "ipbasic" || arg == "ipbasic-fast") {
       lidar.completion = CompletionMethod::ip_basic_fast;
     } else if (arg == "ipbasic-multiscale") {
       lidar.completion = CompletionMethod::ip_basic_multiscale;
@@ -31,7 +33,7 @@ void apply_depth_spec(const std::string& spec, Pipeline& p) {
       // <shape><size>, e.g. diamond5, rectangle3, cross7
       const auto digit = arg.find_first_of("0123456789");
       if (digit == std::string::npos || digit == 0) {
-        throw ConfigError("--depth", fmt::format("lidar, lidar:ipbasic, lidar:ipbasic-multiscale or "
+        throw ConfigError("--depth", fmt::format("lidar, lidar:dilated, lidar:ipbasic, lidar:ipbasic-multiscale or "
                                                  "lidar:<diamond|rectangle|cross><size>, not '{}'",
                                                  spec));
       }
@@ -108,7 +110,7 @@ void add_input_options(CLI::App& app, InputOptions& options) {
   app.add_option("--camera", options.camera, "Tracked camera: 0 (grey left, the default when present) or 2 (colour left)")
       ->check(CLI::IsMember({0, 2}));
   app.add_option("--depth", options.depth,
-                 "Depth source: lidar (5x5 diamond), lidar:ipbasic, lidar:ipbasic-multiscale, lidar:diamond7, "
+                 "Depth source: lidar (5x5 diamond; keypoints at their surface's mean depth), lidar:dilated (keypoints at the dilated value, as the paper), lidar:ipbasic, lidar:ipbasic-multiscale, lidar:diamond7, "
                  "precomputed:<dir>, stereo (SGBM), stereo_sparse (keypoints only), rgbd")
       ->capture_default_str();
   app.add_option("--config", options.config, "Settings YAML (ORB-SLAM style; RGB-L LiDAR.* keys accepted)");

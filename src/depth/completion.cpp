@@ -544,7 +544,83 @@ KeypointDepth lookup_one(const cv::Mat_<float>& sparse, std::span<const Cell> ce
   return result;
 }
 
+KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const Cell> cells, int radius,
+                                 const Inversion& inv, float surface_tolerance, const Eigen::Vector2f& pixel) {
+  KeypointDepth result;
+  const float fx = std::floor(pixel.x() + 0.5F), fy = std::floor(pixel.y() + 0.5F);
+  if (!(fx >= 0.0F && fy >= 0.0F && fx < static_cast<float>(sparse.cols) && fy < static_cast<float>(sparse.rows))) {
+    return result;
+  }
+  const int x = static_cast<int>(fx), y = static_cast<int>(fy);
+  const bool inside = x >= radius && y >= radius && x + radius < sparse.cols && y + radius < sparse.rows;
+  const float* centre = sparse[y] + x;
+  const auto step = static_cast<std::ptrdiff_t>(sparse.step1());
+  struct Sample {
+    int dx, dy;
+    float d;
+    bool on_surface;
+  };
+  // at most the kernel's cells (13 for the 5x5 diamond): small enough for the quadratic growth below
+  std::vector<Sample> samples;
+  samples.reserve(cells.size());
+  std::size_t nearest = 0;
+  for (const Cell& cell : cells) {
+    if (!inside && (x + cell.dx < 0 || y + cell.dy < 0 || x + cell.dx >= sparse.cols || y + cell.dy >= sparse.rows)) continue;
+    const float d = centre[cell.dy * step + cell.dx];
+    if (!(inv.forward(d) > 0.0F)) continue;
+    if (!samples.empty() && d < samples[nearest].d) nearest = samples.size();
+    samples.push_back({cell.dx, cell.dy, d, false});
+  }
+  if (samples.empty()) return result;
+  // The winning surface grows from the nearest sample through samples within 2 px of it whose depths
+  // differ by at most surface_tolerance: a slanted road joins row by row, a jump to the background does not.
+  samples[nearest].on_surface = true;
+  for (bool grown = true; grown;) {
+    grown = false;
+    for (Sample& s : samples) {
+      if (s.on_surface) continue;
+      for (const Sample& t : samples) {
+        if (!t.on_surface || std::abs(s.dx - t.dx) > 2 || std::abs(s.dy - t.dy) > 2) continue;
+        if (std::abs(s.d - t.d) > surface_tolerance * std::min(s.d, t.d)) continue;
+        s.on_surface = grown = true;
+        break;
+      }
+    }
+  }
+  float lo = std::numeric_limits<float>::max(), hi = 0.0F;
+  double weights = 0.0, inverse_depths = 0.0;
+  float nearest2 = std::numeric_limits<float>::max();
+  for (const Sample& s : samples) {
+    lo = std::min(lo, s.d);
+    hi = std::max(hi, s.d);
+    if (!s.on_surface) continue;
+    const float ex = static_cast<float>(x + s.dx) - pixel.x(), ey = static_cast<float>(y + s.dy) - pixel.y();
+    const float distance2 = ex * ex + ey * ey;
+    nearest2 = std::min(nearest2, distance2);
+    const double w = 1.0 / std::max(0.5, std::sqrt(static_cast<double>(distance2)));
+    weights += w;
+    inverse_depths += w / s.d;
+  }
+  result.z = static_cast<float>(weights / inverse_depths);
+  result.sample_distance_px = std::sqrt(nearest2);
+  result.spread = hi - lo;
+  return result;
+}
+
 }  // namespace
+
+void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, float surface_tolerance,
+                          std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) {
+  options.validate();
+  require(surface_tolerance >= 0.0F && surface_tolerance < 1.0F, "lidar.surface_tolerance", "a fraction in [0, 1)");
+  CV_Assert(out.size() == pixels.size());
+  const Kernel kernel = options.kernel();
+  const std::vector<Cell> cells = kernel_cells(kernel);
+  const Inversion inv(options.max_depth);
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    out[i] = lookup_surface_one(sparse, cells, kernel.radius(), inv, surface_tolerance, pixels[i]);
+  }
+}
 
 KeypointDepth lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, const Eigen::Vector2f& pixel) {
   KeypointDepth out;

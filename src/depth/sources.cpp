@@ -25,6 +25,7 @@ void LidarSourceOptions::validate() const {
   projection.validate();
   dilation.validate();
   ip_basic.validate();
+  require(surface_tolerance >= 0.0F && surface_tolerance < 1.0F, "lidar.surface_tolerance", "a fraction in [0, 1)");
 }
 
 void PrecomputedSourceOptions::validate() const {
@@ -137,7 +138,11 @@ class LidarDepthSource final : public DepthSource {
 
   void sample(std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) const override {
     if (options_.completion == CompletionMethod::dilation) {
-      lookup_depth(sparse_, options_.dilation, pixels, out);
+      if (options_.keypoint_depth == KeypointDepthRule::surface_mean) {
+        lookup_surface_depth(sparse_, options_.dilation, options_.surface_tolerance, pixels, out);
+      } else {
+        lookup_depth(sparse_, options_.dilation, pixels, out);
+      }
       return;
     }
     sample_dense_depth(dense_, options_.dilation.kernel(), pixels, out);

@@ -188,3 +188,48 @@ TEST_CASE("density counts pixels with depth") {
   CHECK(rgbl::depth_density(d) == Approx(0.1));
   CHECK(rgbl::depth_density(cv::Mat_<float>()) == 0.0);
 }
+
+TEST_CASE("surface-mean keypoint depth removes the minimum's bias on a slanted plane and keeps the foreground") {
+  // A road seen by a camera 1.65 m above it (fx = fy = 350, horizon at row 0): inverse depth is affine
+  // in the image row, 1/z = v / (350 * 1.65). Every pixel of rows 40-89 holds a sample.
+  const double f = 350.0, h = 1.65;
+  cv::Mat_<float> sparse(90, 40, 0.0F);
+  for (int v = 40; v < 90; ++v) {
+    for (int u = 0; u < 40; ++u) sparse(v, u) = static_cast<float>(f * h / v);
+  }
+  const Eigen::Vector2f pixel(20.0F, 58.0F);
+  const double truth = f * h / 58.0;  // 9.96 m
+  const rgbl::KeypointDepth dilated = rgbl::lookup_depth(sparse, {}, pixel);
+  rgbl::KeypointDepth surface;
+  rgbl::lookup_surface_depth(sparse, {}, 0.05F, std::span<const Eigen::Vector2f>(&pixel, 1),
+                             std::span<rgbl::KeypointDepth>(&surface, 1));
+  // the minimum comes from two rows below: 3.3 % nearer than the road under the keypoint
+  CHECK(dilated.z == Approx(f * h / 60.0).epsilon(1e-6));
+  CHECK(dilated.z < 0.97 * truth);
+  // the diamond is symmetric about the keypoint, so the weighted mean of an affine inverse depth is exact
+  CHECK(surface.z == Approx(truth).epsilon(1e-5));
+  CHECK(surface.sample_distance_px == 0.0F);
+  CHECK(surface.spread == dilated.spread);
+
+  // A foreground post (10 m) in front of a wall (30 m): the wall's samples under the kernel are left
+  // out, so the keypoint on the post keeps the post's depth.
+  cv::Mat_<float> edge(20, 20, 0.0F);
+  for (int v = 0; v < 20; ++v) {
+    for (int u = 0; u < 20; ++u) edge(v, u) = u <= 9 ? 10.0F : 30.0F;
+  }
+  rgbl::KeypointDepth post;
+  const Eigen::Vector2f on_edge(10.0F, 10.0F);  // on the wall, one pixel beside the post
+  rgbl::lookup_surface_depth(edge, {}, 0.05F, std::span<const Eigen::Vector2f>(&on_edge, 1),
+                             std::span<rgbl::KeypointDepth>(&post, 1));
+  CHECK(post.z == Approx(10.0F));
+  CHECK(post.sample_distance_px == Approx(1.0F));
+  CHECK(post.spread == Approx(20.0F));
+  rgbl::KeypointDepth outside;
+  const Eigen::Vector2f off_image(-3.0F, 5.0F);
+  rgbl::lookup_surface_depth(edge, {}, 0.05F, std::span<const Eigen::Vector2f>(&off_image, 1),
+                             std::span<rgbl::KeypointDepth>(&outside, 1));
+  CHECK(outside.z == 0.0F);
+  CHECK_THROWS_AS(rgbl::lookup_surface_depth(edge, {}, 1.5F, std::span<const Eigen::Vector2f>(&on_edge, 1),
+                                             std::span<rgbl::KeypointDepth>(&post, 1)),
+                  rgbl::ConfigError);
+}

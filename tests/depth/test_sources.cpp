@@ -108,35 +108,52 @@ TEST_CASE("lidar source: projects, samples keypoints and agrees with its dense m
   CHECK(dense(24, 35) == 20.0F);
 }
 
-TEST_CASE("lidar source on real frames: keypoint samples equal the dense map") {
+TEST_CASE("lidar source on real frames: keypoint samples equal the dense map (dilated) or lie on its surface") {
   const auto seq = rgbl::test::kitti_seq04();
   if (!seq) return;
-  const auto settings = kitti_settings(*seq);
-  auto source = rgbl::DepthSourceRegistry::with_builtins().create("lidar", settings);
+  auto settings = kitti_settings(*seq);
   const auto scan = rgbl::read_kitti_scan(*seq / "velodyne" / "000010.bin");
   rgbl::SensorFrame frame;
   frame.index = 10;
   frame.scan = scan;
-  source->prepare(frame);
-  const cv::Mat_<float> dense = source->dense_depth();
-  CHECK(rgbl::depth_density(dense) > 0.2);
   std::vector<Eigen::Vector2f> pixels;
-  for (int y = 0; y < dense.rows; y += 3)
-    for (int x = 0; x < dense.cols; x += 2) pixels.emplace_back(static_cast<float>(x) + 0.3F, static_cast<float>(y) - 0.4F);
-  std::vector<rgbl::KeypointDepth> out(pixels.size());
-  source->sample(pixels, out);
-  std::size_t mismatches = 0, with_depth = 0;
+  for (int y = 0; y < 370; y += 3)
+    for (int x = 0; x < 1226; x += 2) pixels.emplace_back(static_cast<float>(x) + 0.3F, static_cast<float>(y) - 0.4F);
+  auto sample = [&](rgbl::KeypointDepthRule rule, cv::Mat_<float>& dense) {
+    settings.lidar.keypoint_depth = rule;
+    auto source = rgbl::DepthSourceRegistry::with_builtins().create("lidar", settings);
+    source->prepare(frame);
+    dense = source->dense_depth();
+    std::vector<rgbl::KeypointDepth> out(pixels.size());
+    source->sample(pixels, out);
+    return out;
+  };
+  cv::Mat_<float> dense, dense_surface;
+  const auto dilated = sample(rgbl::KeypointDepthRule::dilated, dense);
+  const auto surface = sample(rgbl::KeypointDepthRule::surface_mean, dense_surface);
+  CHECK(rgbl::depth_density(dense) > 0.2);
+  REQUIRE(dense.size() == cv::Size(1226, 370));
+  std::size_t mismatches = 0, with_depth = 0, off_surface = 0, changed = 0;
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     const float expected = dense(static_cast<int>(std::floor(pixels[i].y() + 0.5F)), static_cast<int>(std::floor(pixels[i].x() + 0.5F)));
-    mismatches += std::memcmp(&expected, &out[i].z, sizeof(float)) != 0 ? 1U : 0U;
-    if (out[i].z > 0.0F) {
+    mismatches += std::memcmp(&expected, &dilated[i].z, sizeof(float)) != 0 ? 1U : 0U;
+    CHECK((surface[i].z > 0.0F) == (dilated[i].z > 0.0F));  // the same pixels have depth
+    if (dilated[i].z > 0.0F) {
       ++with_depth;
       // the farthest diamond cell from (x + 0.3, y - 0.4) is (x, y + 2)
-      CHECK(out[i].sample_distance_px <= std::hypot(0.3F, 2.4F) + 1e-4F);
-      CHECK(out[i].spread >= 0.0F);
+      CHECK(dilated[i].sample_distance_px <= std::hypot(0.3F, 2.4F) + 1e-4F);
+      CHECK(dilated[i].spread >= 0.0F);
+      CHECK(surface[i].spread == dilated[i].spread);
+      CHECK(surface[i].sample_distance_px <= std::hypot(0.3F, 2.4F) + 1e-4F);
+      // the surface mean is never nearer than the minimum and stays on the nearest surface
+      off_surface += surface[i].z < dilated[i].z - 1e-4F || surface[i].z > dilated[i].z + dilated[i].spread + 1e-4F ? 1U : 0U;
+      changed += surface[i].z != dilated[i].z ? 1U : 0U;
     }
   }
+  CHECK(bool(cv::norm(dense, dense_surface, cv::NORM_INF) == 0.0));  // the dense map is the paper's either way
   CHECK(mismatches == 0);
+  CHECK(off_surface == 0);
+  CHECK(changed > 0);
   CHECK(with_depth > pixels.size() / 5);
 }
 

@@ -70,6 +70,18 @@ void lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions& options,
                   std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out);
 KeypointDepth lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, const Eigen::Vector2f& pixel);
 
+// The dilation's keypoint depth without its bias towards the camera. The same kernel and the same
+// foreground rule (the nearest surface under the kernel wins), but z is the inverse-distance-weighted
+// mean, in inverse depth, of the samples on that surface instead of the nearest depth itself: on every
+// slanted surface the minimum comes from the side that faces the camera (on the road about
+// z^2 / (fx h) per pixel of kernel), the mean does not. The surface grows from the nearest sample
+// through samples within 2 px whose depths differ by at most surface_tolerance (relative), so a road
+// joins row by row and a background behind an edge stays out. Weights are 1 / max(distance, 0.5 px).
+// sample_distance_px is the nearest surface sample's distance; spread is as for lookup_depth. Pixels
+// outside the image get z = 0.
+void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, float surface_tolerance,
+                          std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out);
+
 // Share of pixels with depth (> 0), in [0, 1].
 double depth_density(const cv::Mat_<float>& depth);
 
