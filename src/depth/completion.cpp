@@ -560,7 +560,6 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
     float d;
     bool on_surface;
   };
-  // at most the kernel's cells (13 for the 5x5 diamond): small enough for the quadratic growth below
   std::vector<Sample> samples;
   samples.reserve(cells.size());
   std::size_t nearest = 0;
@@ -574,17 +573,18 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
   if (samples.empty()) return result;
   // The winning surface grows from the nearest sample through samples within 2 px of it whose depths
   // differ by at most surface_tolerance: a slanted road joins row by row, a jump to the background does not.
+  // Breadth-first: each sample joins once, so the cost is quadratic in the samples under the kernel.
   samples[nearest].on_surface = true;
-  for (bool grown = true; grown;) {
-    grown = false;
-    for (Sample& s : samples) {
-      if (s.on_surface) continue;
-      for (const Sample& t : samples) {
-        if (!t.on_surface || std::abs(s.dx - t.dx) > 2 || std::abs(s.dy - t.dy) > 2) continue;
-        if (std::abs(s.d - t.d) > surface_tolerance * std::min(s.d, t.d)) continue;
-        s.on_surface = grown = true;
-        break;
-      }
+  std::vector<std::size_t> frontier = {nearest};
+  while (!frontier.empty()) {
+    const Sample t = samples[frontier.back()];
+    frontier.pop_back();
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      Sample& s = samples[i];
+      if (s.on_surface || std::abs(s.dx - t.dx) > 2 || std::abs(s.dy - t.dy) > 2) continue;
+      if (std::abs(s.d - t.d) > surface_tolerance * std::min(s.d, t.d)) continue;
+      s.on_surface = true;
+      frontier.push_back(i);
     }
   }
   float lo = std::numeric_limits<float>::max(), hi = 0.0F;
