@@ -5,7 +5,8 @@
 
 Prints how far the estimated heading is from the ground truth's, how far the ground truth's own steps
 point from its own heading (a car drives where it points: ~0 on a consistent truth), and the end-point
-error split into the first camera's x (sideways), y (down) and z (forward) axes.
+error split into the first camera's x (sideways), y (down) and z (forward) axes, and the estimated
+path's length over the truth's (a scale error shows as a ratio off 1).
 """
 import sys
 
@@ -28,3 +29,5 @@ for i in range(1, len(gt)):
 off = np.array(off)
 print(f"truth's step direction - truth's heading: mean {off.mean():.2f} deg, max |.| {np.abs(off).max():.2f} deg")
 print("end-point error x (sideways), y, z (forward): " + " ".join(f"{v:.3f}" for v in est[-1, :, 3] - gt[-1, :, 3]) + " m")
+length = lambda poses: np.linalg.norm(np.diff(poses[:, :, 3], axis=0), axis=1).sum()
+print(f"path length estimate / truth: {length(est) / length(gt):.4f}")

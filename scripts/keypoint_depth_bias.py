@@ -8,7 +8,8 @@
 At ORB keypoints (OpenCV's, 2000 per frame) the scan is projected into camera 0 and both rules of
 src/depth/completion.cpp are applied (`lookup_depth`: the nearest depth under the kernel;
 `lookup_surface_depth`: the inverse-distance-weighted inverse-depth mean of the samples connected to
-the nearest one by steps of at most 5 %). Keypoints whose kernel spans a depth edge (spread >
+the nearest one by steps of at most 5 %), restated here in Python because the library exports no
+keypoint-level lookup to scripts: keep the two in step with completion.cpp. Keypoints whose kernel spans a depth edge (spread >
 max(1 m, 5 %), dropped by the tracker's noise model) are left out. Truth: the simulator's exact depth
 image, or for KITTI the scans of the 10 neighbouring frames moved by the ground-truth poses (the
 median within 1 px). Also prints how many LiDAR rows the kernels hold: the minimum's bias comes from

@@ -13,8 +13,8 @@
 namespace rgbl::cli {
 namespace {
 
-// --depth: lidar | lidar:dilated | lidar:ipbasic | lidar:ipbasic-multiscale | lidar:<kernel><size> (e.g. lidar:diamond7)
-// | precomputed:<dir> | stereo | stereo_sparse | rgbd
+// --depth: lidar | lidar:dilated | lidar:ipbasic | lidar:ipbasic-multiscale | lidar:<kernel><size>
+// (e.g. lidar:diamond7) | precomputed:<dir> | stereo | stereo_sparse | rgbd
 void apply_depth_spec(const std::string& spec, Pipeline& p) {
   const auto colon = spec.find(':');
   const std::string name = spec.substr(0, colon);
@@ -110,7 +110,8 @@ void add_input_options(CLI::App& app, InputOptions& options) {
   app.add_option("--camera", options.camera, "Tracked camera: 0 (grey left, the default when present) or 2 (colour left)")
       ->check(CLI::IsMember({0, 2}));
   app.add_option("--depth", options.depth,
-                 "Depth source: lidar (5x5 diamond; keypoints at their surface's mean depth), lidar:dilated (keypoints at the dilated value, as the paper), lidar:ipbasic, lidar:ipbasic-multiscale, lidar:diamond7, "
+                 "Depth source: lidar (5x5 diamond; keypoints at their surface's mean depth), lidar:dilated "
+                 "(keypoints at the dilated value, as the paper), lidar:ipbasic, lidar:ipbasic-multiscale, lidar:diamond7, "
                  "precomputed:<dir>, stereo (SGBM), stereo_sparse (keypoints only), rgbd")
       ->capture_default_str();
   app.add_option("--config", options.config, "Settings YAML (ORB-SLAM style; RGB-L LiDAR.* keys accepted)");

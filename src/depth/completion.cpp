@@ -504,23 +504,53 @@ std::vector<Cell> kernel_cells(const Kernel& kernel) {
   return cells;
 }
 
+// The kernel around the pixel centre nearest to a keypoint: which cells lie in the image, and their
+// values. Empty (no cells) when that centre is outside the image.
+class KernelWindow {
+ public:
+  KernelWindow(const cv::Mat_<float>& sparse, int radius, const Eigen::Vector2f& pixel) {
+    const float fx = std::floor(pixel.x() + 0.5F), fy = std::floor(pixel.y() + 0.5F);
+    if (!(fx >= 0.0F && fy >= 0.0F && fx < static_cast<float>(sparse.cols) && fy < static_cast<float>(sparse.rows))) {
+      return;
+    }
+    x_ = static_cast<int>(fx);
+    y_ = static_cast<int>(fy);
+    cols_ = sparse.cols;
+    rows_ = sparse.rows;
+    inside_ = x_ >= radius && y_ >= radius && x_ + radius < cols_ && y_ + radius < rows_;
+    centre_ = sparse[y_] + x_;
+    step_ = static_cast<std::ptrdiff_t>(sparse.step1());
+  }
+
+  bool empty() const { return centre_ == nullptr; }
+  bool holds(const Cell& c) const {
+    return inside_ || (x_ + c.dx >= 0 && y_ + c.dy >= 0 && x_ + c.dx < cols_ && y_ + c.dy < rows_);
+  }
+  float at(const Cell& c) const { return centre_[c.dy * step_ + c.dx]; }
+  // squared distance from the keypoint to the centre of cell c
+  float distance2(const Cell& c, const Eigen::Vector2f& pixel) const {
+    const float ex = static_cast<float>(x_ + c.dx) - pixel.x(), ey = static_cast<float>(y_ + c.dy) - pixel.y();
+    return ex * ex + ey * ey;
+  }
+
+ private:
+  const float* centre_ = nullptr;
+  std::ptrdiff_t step_ = 0;
+  int x_ = 0, y_ = 0, cols_ = 0, rows_ = 0;
+  bool inside_ = false;
+};
+
 KeypointDepth lookup_one(const cv::Mat_<float>& sparse, std::span<const Cell> cells, int radius, const Inversion& inv,
                          const Eigen::Vector2f& pixel) {
   KeypointDepth result;
-  const float fx = std::floor(pixel.x() + 0.5F), fy = std::floor(pixel.y() + 0.5F);
-  if (!(fx >= 0.0F && fy >= 0.0F && fx < static_cast<float>(sparse.cols) && fy < static_cast<float>(sparse.rows))) {
-    return result;
-  }
-  const int x = static_cast<int>(fx), y = static_cast<int>(fy);
-  const bool inside = x >= radius && y >= radius && x + radius < sparse.cols && y + radius < sparse.rows;
-  const float* centre = sparse[y] + x;
-  const auto step = static_cast<std::ptrdiff_t>(sparse.step1());
+  const KernelWindow window(sparse, radius, pixel);
+  if (window.empty()) return result;
   // First pass: the winning inverted value and the depth range; cells outside the image are skipped.
   float best = 0.0F;
   float lo = std::numeric_limits<float>::max(), hi = 0.0F;
   for (const Cell& cell : cells) {
-    if (!inside && (x + cell.dx < 0 || y + cell.dy < 0 || x + cell.dx >= sparse.cols || y + cell.dy >= sparse.rows)) continue;
-    const float d = centre[cell.dy * step + cell.dx];
+    if (!window.holds(cell)) continue;
+    const float d = window.at(cell);
     const float v = inv.forward(d);
     if (v > 0.0F) {
       lo = std::min(lo, d);
@@ -534,54 +564,56 @@ KeypointDepth lookup_one(const cv::Mat_<float>& sparse, std::span<const Cell> ce
   // Second pass, only for keypoints with depth: the nearest cell holding the winning value.
   float best_distance2 = std::numeric_limits<float>::max();
   for (const Cell& cell : cells) {
-    if (!inside && (x + cell.dx < 0 || y + cell.dy < 0 || x + cell.dx >= sparse.cols || y + cell.dy >= sparse.rows)) continue;
-    if (inv.forward(centre[cell.dy * step + cell.dx]) != best) continue;
-    const float ex = static_cast<float>(x + cell.dx) - pixel.x(), ey = static_cast<float>(y + cell.dy) - pixel.y();
-    best_distance2 = std::min(best_distance2, ex * ex + ey * ey);
+    if (!window.holds(cell) || inv.forward(window.at(cell)) != best) continue;
+    best_distance2 = std::min(best_distance2, window.distance2(cell, pixel));
   }
   result.sample_distance_px = std::sqrt(best_distance2);
   result.spread = hi - lo;
   return result;
 }
 
+// A LiDAR sample under the kernel, and whether it belongs to the winning surface.
+struct SurfaceSample {
+  Cell cell;
+  float d;
+  bool on_surface;
+};
+
+// Scratch of lookup_surface_one, kept across the keypoints of one call (no allocation per keypoint).
+struct SurfaceScratch {
+  std::vector<SurfaceSample> samples;
+  std::vector<std::size_t> frontier;
+};
+
 KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const Cell> cells, int radius,
-                                 const Inversion& inv, float surface_tolerance, const Eigen::Vector2f& pixel) {
+                                 const Inversion& inv, float surface_tolerance, const Eigen::Vector2f& pixel,
+                                 SurfaceScratch& scratch) {
   KeypointDepth result;
-  const float fx = std::floor(pixel.x() + 0.5F), fy = std::floor(pixel.y() + 0.5F);
-  if (!(fx >= 0.0F && fy >= 0.0F && fx < static_cast<float>(sparse.cols) && fy < static_cast<float>(sparse.rows))) {
-    return result;
-  }
-  const int x = static_cast<int>(fx), y = static_cast<int>(fy);
-  const bool inside = x >= radius && y >= radius && x + radius < sparse.cols && y + radius < sparse.rows;
-  const float* centre = sparse[y] + x;
-  const auto step = static_cast<std::ptrdiff_t>(sparse.step1());
-  struct Sample {
-    int dx, dy;
-    float d;
-    bool on_surface;
-  };
-  std::vector<Sample> samples;
-  samples.reserve(cells.size());
+  const KernelWindow window(sparse, radius, pixel);
+  if (window.empty()) return result;
+  auto& samples = scratch.samples;
+  samples.clear();
   std::size_t nearest = 0;
   for (const Cell& cell : cells) {
-    if (!inside && (x + cell.dx < 0 || y + cell.dy < 0 || x + cell.dx >= sparse.cols || y + cell.dy >= sparse.rows)) continue;
-    const float d = centre[cell.dy * step + cell.dx];
+    if (!window.holds(cell)) continue;
+    const float d = window.at(cell);
     if (!(inv.forward(d) > 0.0F)) continue;
     if (!samples.empty() && d < samples[nearest].d) nearest = samples.size();
-    samples.push_back({cell.dx, cell.dy, d, false});
+    samples.push_back({cell, d, false});
   }
   if (samples.empty()) return result;
   // The winning surface grows from the nearest sample through samples within 2 px of it whose depths
   // differ by at most surface_tolerance: a slanted road joins row by row, a jump to the background does not.
   // Breadth-first: each sample joins once, so the cost is quadratic in the samples under the kernel.
   samples[nearest].on_surface = true;
-  std::vector<std::size_t> frontier = {nearest};
+  auto& frontier = scratch.frontier;
+  frontier.assign(1, nearest);
   while (!frontier.empty()) {
-    const Sample t = samples[frontier.back()];
+    const SurfaceSample t = samples[frontier.back()];
     frontier.pop_back();
     for (std::size_t i = 0; i < samples.size(); ++i) {
-      Sample& s = samples[i];
-      if (s.on_surface || std::abs(s.dx - t.dx) > 2 || std::abs(s.dy - t.dy) > 2) continue;
+      SurfaceSample& s = samples[i];
+      if (s.on_surface || std::abs(s.cell.dx - t.cell.dx) > 2 || std::abs(s.cell.dy - t.cell.dy) > 2) continue;
       if (std::abs(s.d - t.d) > surface_tolerance * std::min(s.d, t.d)) continue;
       s.on_surface = true;
       frontier.push_back(i);
@@ -590,12 +622,11 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
   float lo = std::numeric_limits<float>::max(), hi = 0.0F;
   double weights = 0.0, inverse_depths = 0.0;
   float nearest2 = std::numeric_limits<float>::max();
-  for (const Sample& s : samples) {
+  for (const SurfaceSample& s : samples) {
     lo = std::min(lo, s.d);
     hi = std::max(hi, s.d);
     if (!s.on_surface) continue;
-    const float ex = static_cast<float>(x + s.dx) - pixel.x(), ey = static_cast<float>(y + s.dy) - pixel.y();
-    const float distance2 = ex * ex + ey * ey;
+    const float distance2 = window.distance2(s.cell, pixel);
     nearest2 = std::min(nearest2, distance2);
     const double w = 1.0 / std::max(0.5, std::sqrt(static_cast<double>(distance2)));
     weights += w;
@@ -617,8 +648,11 @@ void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& 
   const Kernel kernel = options.kernel();
   const std::vector<Cell> cells = kernel_cells(kernel);
   const Inversion inv(options.max_depth);
+  SurfaceScratch scratch;
+  scratch.samples.reserve(cells.size());
+  scratch.frontier.reserve(cells.size());
   for (std::size_t i = 0; i < pixels.size(); ++i) {
-    out[i] = lookup_surface_one(sparse, cells, kernel.radius(), inv, surface_tolerance, pixels[i]);
+    out[i] = lookup_surface_one(sparse, cells, kernel.radius(), inv, surface_tolerance, pixels[i], scratch);
   }
 }
 

@@ -116,9 +116,10 @@ TEST_CASE("lidar source on real frames: keypoint samples equal the dense map (di
   rgbl::SensorFrame frame;
   frame.index = 10;
   frame.scan = scan;
+  const int width = settings.calibration.camera.width, height = settings.calibration.camera.height;
   std::vector<Eigen::Vector2f> pixels;
-  for (int y = 0; y < 370; y += 3)
-    for (int x = 0; x < 1226; x += 2) pixels.emplace_back(static_cast<float>(x) + 0.3F, static_cast<float>(y) - 0.4F);
+  for (int y = 0; y < height; y += 3)
+    for (int x = 0; x < width; x += 2) pixels.emplace_back(static_cast<float>(x) + 0.3F, static_cast<float>(y) - 0.4F);
   auto sample = [&](rgbl::KeypointDepthRule rule, cv::Mat_<float>& dense) {
     settings.lidar.keypoint_depth = rule;
     auto source = rgbl::DepthSourceRegistry::with_builtins().create("lidar", settings);
@@ -132,7 +133,7 @@ TEST_CASE("lidar source on real frames: keypoint samples equal the dense map (di
   const auto dilated = sample(rgbl::KeypointDepthRule::dilated, dense);
   const auto surface = sample(rgbl::KeypointDepthRule::surface_mean, dense_surface);
   CHECK(rgbl::depth_density(dense) > 0.2);
-  REQUIRE(dense.size() == cv::Size(1226, 370));
+  REQUIRE(dense.size() == cv::Size(width, height));
   std::size_t mismatches = 0, with_depth = 0, off_surface = 0, changed = 0;
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     const float expected = dense(static_cast<int>(std::floor(pixels[i].y() + 0.5F)), static_cast<int>(std::floor(pixels[i].x() + 0.5F)));

@@ -20,23 +20,23 @@ enum class CompletionMethod { dilation, ip_basic_fast, ip_basic_multiscale };
 // Parses "dilation" / "ip_basic_fast" / "ip_basic_multiscale"; throws ConfigError(key) otherwise.
 CompletionMethod parse_completion_method(std::string_view text, const char* key = "lidar.completion");
 
+// Depth at a keypoint with dilation: the mean of the winning surface (lookup_surface_depth, the
+// default), or the dense map's value exactly (the paper's), whose minimum leans towards the camera
+// wherever the kernel spans a depth gradient. On KITTI (1241 px wide) 96 % of the 5x5 kernels at
+// keypoints hold a single LiDAR row and the bias is small; with more LiDAR rows per pixel (a smaller
+// image, a LiDAR with more rows; the simulator's 613 px images) it grows: ~0.5 % there (docs/depth.md).
+enum class KeypointDepthRule { dilated, surface_mean };
+
 // `lidar`: the scan projected into the tracked camera (z-buffer), completed by inverse dilation (the
 // paper's 5x5 diamond by default) or by IP-Basic. With dilation, sample() reads keypoints straight
 // from the sparse image (no dense map).
-// Depth at a keypoint with dilation: the mean of the winning surface (lookup_surface_depth, the
-// default), or the dense map's value exactly (the paper's), whose minimum leans towards the camera
-// wherever the kernel spans a depth gradient. On KITTI (1241 px wide) 95 % of the 5x5 kernels at
-// keypoints hold a single LiDAR row and the bias is small; where the LiDAR is denser per pixel (a
-// smaller image, a 128-beam sensor, the simulator's 613 px images) it grows to ~0.5-1 % of depth.
-enum class KeypointDepthRule { dilated, surface_mean };
-
 struct LidarSourceOptions {
   ProjectionOptions projection{};
   CompletionMethod completion = CompletionMethod::dilation;
   DilationOptions dilation{};
   IpBasicOptions ip_basic{};
   KeypointDepthRule keypoint_depth = KeypointDepthRule::surface_mean;
-  float surface_tolerance = 0.05F;  // samples within this fraction beyond the nearest depth are its surface
+  float surface_tolerance = 0.05F;  // relative depth step between neighbouring samples of one surface
 
   void validate() const;
 };
