@@ -1,0 +1,57 @@
+#pragma once
+// Geometric verification of a loop candidate with metric depth: the current keyframe's keypoints that
+// have depth (3-D points in its camera) are matched by descriptor to the landmarks of the candidate
+// keyframe and its best covisible neighbours (3-D points in the map), a 3-point RANSAC finds the rigid
+// motion that aligns them (SE(3): depth is metric, no scale), and the pose of the current keyframe in
+// the candidate's map is refined on reprojection and depth. A loop is the relative pose between the
+// two keyframes; it is only a loop when enough matches agree, and a false loop is worse than none,
+// so every threshold errs on the side of rejecting.
+
+#include "rgbl/backend/loop_correction.hpp"
+#include "rgbl/geometry/camera.hpp"
+#include "rgbl/map/map.hpp"
+
+#include <cstdint>
+#include <optional>
+
+namespace rgbl {
+
+struct LoopVerificationOptions {
+  std::size_t neighbours = 5;   // best covisible keyframes of the candidate whose landmarks join
+  int max_hamming = 50;         // descriptor distance of a match
+  float ratio = 0.75F;          // best < ratio * second best (a loop is matched without a pose prior)
+  int ransac_iterations = 300;
+  std::uint32_t seed = 1;       // fixed: the same map gives the same answer
+  // A match agrees with a motion within max(min_tolerance, relative_tolerance * z) m in 3-D.
+  double min_tolerance = 0.15;
+  double relative_tolerance = 0.02;
+  int min_ransac_inliers = 30;
+  int min_inliers = 40;         // after pose refinement (ORB-SLAM asks 40 for a loop, with a Sim3)
+  double min_inlier_ratio = 0.3;  // of the matches: a few agreeing among many random ones is chance
+
+  void validate() const;
+};
+
+// How far a candidate got: also filled for a rejected one (the reason is the first count below its
+// threshold; 0 after it: not reached).
+struct LoopVerificationCounts {
+  int matches = 0;         // descriptor matches
+  int ransac_inliers = 0;  // agreeing with the best 3-point motion (after refitting on its consensus)
+  int inliers = 0;         // after pose refinement
+};
+
+struct LoopVerification {
+  LoopConstraint constraint;  // T_current_matched measured through the matched landmarks
+  Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();  // current keyframe in the candidate's map
+  LoopVerificationCounts counts;
+};
+
+// `camera` is the current keyframe's. `current` is a keyframe, possibly of another map (merging): only
+// its keypoints, descriptors and depths are used, not its pose or landmarks. `candidate` is a keyframe of
+// `map`. nullopt: not verified; `counts` (optional) says how far it got. Throws ConfigError on bad
+// options. Read-only on the map: the caller holds its lock (shared is enough).
+std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const Keyframe& current, const Map& map,
+                                            KeyframeId candidate, const LoopVerificationOptions& options = {},
+                                            LoopVerificationCounts* counts = nullptr);
+
+}  // namespace rgbl

@@ -1,0 +1,176 @@
+#include "rgbl/loop/verification.hpp"
+
+#include "rgbl/backend/pose_optimizer.hpp"
+#include "rgbl/core/error.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
+#include <vector>
+
+namespace rgbl {
+namespace {
+
+struct Match {
+  int keypoint = 0;
+  Eigen::Vector3d p_cam;    // current keyframe's camera frame, from its depth
+  Eigen::Vector3d p_world;  // the landmark, in the candidate's map
+};
+
+std::vector<Match> match_descriptors(const PinholeCamera& camera, const Keyframe& current, const Map& map,
+                                     const std::vector<LandmarkId>& landmarks, const LoopVerificationOptions& options) {
+  // landmark -> (keypoint, distance): each landmark keeps its best keypoint
+  std::map<int, std::pair<int, int>> best_of_landmark;
+  for (std::size_t i = 0; i < current.keypoints.size(); ++i) {
+    if (i >= current.depth.size() || current.depth[i] <= 0.0F) continue;
+    int best = 256, second = 256;
+    LandmarkId best_id;
+    for (const LandmarkId id : landmarks) {
+      const int d = hamming_distance(current.descriptors[i], map.landmark(id)->descriptor);
+      if (d < best) {
+        second = best;
+        best = d;
+        best_id = id;
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    if (!best_id.valid() || best > options.max_hamming || static_cast<float>(best) >= options.ratio * static_cast<float>(second)) {
+      continue;
+    }
+    const auto it = best_of_landmark.find(best_id.value);
+    if (it == best_of_landmark.end() || best < it->second.second) {
+      best_of_landmark[best_id.value] = {static_cast<int>(i), best};
+    }
+  }
+  std::vector<Match> matches;
+  matches.reserve(best_of_landmark.size());
+  for (const auto& [landmark, kp] : best_of_landmark) {
+    const auto k = static_cast<std::size_t>(kp.first);
+    Match m;
+    m.keypoint = kp.first;
+    m.p_cam = camera.unproject(Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y), current.depth[k]);
+    m.p_world = map.landmark(LandmarkId{landmark})->position;
+    matches.push_back(m);
+  }
+  return matches;
+}
+
+double tolerance(const Match& m, const LoopVerificationOptions& o) {
+  return std::max(o.min_tolerance, o.relative_tolerance * m.p_cam.z());
+}
+
+int count_agreeing(const std::vector<Match>& matches, const Eigen::Isometry3d& T_cam_world,
+                   const LoopVerificationOptions& options, std::vector<char>* agree = nullptr) {
+  int n = 0;
+  if (agree != nullptr) agree->assign(matches.size(), 0);
+  for (std::size_t i = 0; i < matches.size(); ++i) {
+    if ((T_cam_world * matches[i].p_world - matches[i].p_cam).norm() < tolerance(matches[i], options)) {
+      ++n;
+      if (agree != nullptr) (*agree)[i] = 1;
+    }
+  }
+  return n;
+}
+
+// Rigid T_cam_world from matched pairs (Umeyama without scale).
+Eigen::Isometry3d align(const std::vector<Match>& matches, const std::vector<std::size_t>& use) {
+  Eigen::Matrix3Xd world(3, static_cast<Eigen::Index>(use.size())), cam(3, static_cast<Eigen::Index>(use.size()));
+  for (std::size_t k = 0; k < use.size(); ++k) {
+    world.col(static_cast<Eigen::Index>(k)) = matches[use[k]].p_world;
+    cam.col(static_cast<Eigen::Index>(k)) = matches[use[k]].p_cam;
+  }
+  Eigen::Isometry3d T;
+  T.matrix() = Eigen::umeyama(world, cam, false);
+  return T;
+}
+
+}  // namespace
+
+void LoopVerificationOptions::validate() const {
+  require(max_hamming >= 0 && max_hamming <= 256, "loop_verification.max_hamming", "0..256");
+  require(ratio > 0.0F && ratio <= 1.0F, "loop_verification.ratio", "in (0, 1]");
+  require(ransac_iterations >= 1, "loop_verification.ransac_iterations", ">= 1");
+  require(min_tolerance > 0.0 && relative_tolerance >= 0.0, "loop_verification.tolerance",
+          "min_tolerance > 0 m and relative_tolerance >= 0");
+  require(min_ransac_inliers >= 3, "loop_verification.min_ransac_inliers", ">= 3");
+  require(min_inliers >= 3, "loop_verification.min_inliers", ">= 3");
+  require(min_inlier_ratio >= 0.0 && min_inlier_ratio <= 1.0, "loop_verification.min_inlier_ratio", "in [0, 1]");
+}
+
+std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const Keyframe& current, const Map& map,
+                                            KeyframeId candidate, const LoopVerificationOptions& options,
+                                            LoopVerificationCounts* counts) {
+  options.validate();
+  LoopVerificationCounts scratch;
+  LoopVerificationCounts& c = counts != nullptr ? *counts : scratch;
+  c = {};
+  const Keyframe* matched = map.keyframe(candidate);
+  if (matched == nullptr) return std::nullopt;
+  std::vector<KeyframeId> around{candidate};
+  for (const KeyframeId id : map.best_covisible(candidate, options.neighbours)) around.push_back(id);
+  const std::vector<Match> matches = match_descriptors(camera, current, map, map.landmarks_seen_by(around), options);
+  c.matches = static_cast<int>(matches.size());
+  if (c.matches < options.min_ransac_inliers) return std::nullopt;
+
+  // 3-point RANSAC on the 3-D pairs; own index draws (rng() % n), so the samples are the same with
+  // every standard library.
+  std::mt19937 rng(options.seed);
+  const std::size_t n = matches.size();
+  Eigen::Isometry3d best_T = Eigen::Isometry3d::Identity();
+  int best_count = 0;
+  for (int it = 0; it < options.ransac_iterations; ++it) {
+    const std::size_t a = rng() % n, b = rng() % n, c = rng() % n;
+    if (a == b || b == c || a == c) continue;
+    const Eigen::Vector3d& pa = matches[a].p_world;
+    // nearly colinear or tiny samples fix no rotation
+    if ((matches[b].p_world - pa).cross(matches[c].p_world - pa).norm() < 0.5) continue;
+    const Eigen::Isometry3d T = align(matches, {a, b, c});
+    const int count = count_agreeing(matches, T, options);
+    if (count > best_count) {
+      best_count = count;
+      best_T = T;
+    }
+  }
+  c.ransac_inliers = best_count;
+  if (best_count < options.min_ransac_inliers) return std::nullopt;
+  std::vector<char> agree;
+  count_agreeing(matches, best_T, options, &agree);
+  std::vector<std::size_t> consensus;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (agree[i] != 0) consensus.push_back(i);
+  }
+  best_T = align(matches, consensus);
+  c.ransac_inliers = count_agreeing(matches, best_T, options);
+  if (c.ransac_inliers < options.min_ransac_inliers) return std::nullopt;
+
+  // Refine on reprojection and depth of every match; the optimiser re-classifies outliers.
+  std::vector<PoseObservation> observations;
+  observations.reserve(n);
+  for (const Match& m : matches) {
+    const auto k = static_cast<std::size_t>(m.keypoint);
+    PoseObservation o;
+    o.p_world = m.p_world;
+    o.pixel = Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y);
+    o.sigma_px = std::pow(map.options().scale_factor, current.keypoints[k].level);
+    o.depth = current.depth[k];
+    o.depth_sigma = k < current.depth_sigma.size() && current.depth_sigma[k] > 0.0F ? current.depth_sigma[k]
+                                                                                      : tolerance(m, options);
+    observations.push_back(o);
+  }
+  const PoseOptimizerResult refined = optimize_pose(camera, best_T, observations);
+  c.inliers = refined.inliers;
+  if (c.inliers < options.min_inliers || c.inliers < options.min_inlier_ratio * c.matches) return std::nullopt;
+  LoopVerification v;
+  v.counts = c;
+  v.T_cam_world = refined.T_cam_world;
+  v.constraint.current = current.id;
+  v.constraint.matched = candidate;
+  v.constraint.T_current_matched = refined.T_cam_world * matched->T_cam_world.inverse();
+  return v;
+}
+
+}  // namespace rgbl
