@@ -4,6 +4,7 @@
 #include "rgbl/core/error.hpp"
 
 #include <Eigen/Geometry>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -25,7 +26,7 @@ std::vector<Match> match_descriptors(const PinholeCamera& camera, const Keyframe
   // landmark -> (keypoint, distance): each landmark keeps its best keypoint
   std::map<int, std::pair<int, int>> best_of_landmark;
   for (std::size_t i = 0; i < current.keypoints.size(); ++i) {
-    if (i >= current.depth.size() || current.depth[i] <= 0.0F) continue;
+    if (current.depth[i] <= 0.0F) continue;
     int best = 256, second = 256;
     LandmarkId best_id;
     for (const LandmarkId id : landmarks) {
@@ -105,16 +106,22 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
                                             KeyframeId candidate, const LoopVerificationOptions& options,
                                             LoopVerificationCounts* counts) {
   options.validate();
+  if (current.descriptors.size() != current.keypoints.size() || current.depth.size() != current.keypoints.size()) {
+    throw ConfigError("current keyframe", fmt::format("one descriptor and one depth per keypoint (has {} keypoints, {} "
+                                                      "descriptors, {} depths)",
+                                                      current.keypoints.size(), current.descriptors.size(),
+                                                      current.depth.size()));
+  }
   LoopVerificationCounts scratch;
-  LoopVerificationCounts& c = counts != nullptr ? *counts : scratch;
-  c = {};
+  LoopVerificationCounts& reached = counts != nullptr ? *counts : scratch;
+  reached = {};
   const Keyframe* matched = map.keyframe(candidate);
   if (matched == nullptr) return std::nullopt;
   std::vector<KeyframeId> around{candidate};
   for (const KeyframeId id : map.best_covisible(candidate, options.neighbours)) around.push_back(id);
   const std::vector<Match> matches = match_descriptors(camera, current, map, map.landmarks_seen_by(around), options);
-  c.matches = static_cast<int>(matches.size());
-  if (c.matches < options.min_ransac_inliers) return std::nullopt;
+  reached.matches = static_cast<int>(matches.size());
+  if (reached.matches < options.min_ransac_inliers) return std::nullopt;
 
   // 3-point RANSAC on the 3-D pairs; own index draws (rng() % n), so the samples are the same with
   // every standard library.
@@ -135,7 +142,7 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
       best_T = T;
     }
   }
-  c.ransac_inliers = best_count;
+  reached.ransac_inliers = best_count;
   if (best_count < options.min_ransac_inliers) return std::nullopt;
   std::vector<char> agree;
   count_agreeing(matches, best_T, options, &agree);
@@ -144,8 +151,8 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
     if (agree[i] != 0) consensus.push_back(i);
   }
   best_T = align(matches, consensus);
-  c.ransac_inliers = count_agreeing(matches, best_T, options);
-  if (c.ransac_inliers < options.min_ransac_inliers) return std::nullopt;
+  reached.ransac_inliers = count_agreeing(matches, best_T, options);
+  if (reached.ransac_inliers < options.min_ransac_inliers) return std::nullopt;
 
   // Refine on reprojection and depth of every match; the optimiser re-classifies outliers.
   std::vector<PoseObservation> observations;
@@ -162,10 +169,10 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
     observations.push_back(o);
   }
   const PoseOptimizerResult refined = optimize_pose(camera, best_T, observations);
-  c.inliers = refined.inliers;
-  if (c.inliers < options.min_inliers || c.inliers < options.min_inlier_ratio * c.matches) return std::nullopt;
+  reached.inliers = refined.inliers;
+  if (reached.inliers < options.min_inliers || reached.inliers < options.min_inlier_ratio * reached.matches) return std::nullopt;
   LoopVerification v;
-  v.counts = c;
+  v.counts = reached;
   v.T_cam_world = refined.T_cam_world;
   v.constraint.current = current.id;
   v.constraint.matched = candidate;

@@ -119,4 +119,13 @@ TEST_CASE("loop verification options are checked, naming the field") {
   o = {};
   o.min_inliers = 2;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_verification.min_inliers"));
+  // a keyframe whose arrays disagree is refused before anything is indexed
+  rgbl::Map map;
+  rgbl::Keyframe k;
+  k.keypoints.resize(3);
+  k.descriptors.resize(2);
+  k.depth.resize(3);
+  const rgbl::KeyframeId id = map.add_keyframe(rgbl::Keyframe{});
+  const rgbl::PinholeCamera camera{};
+  CHECK_THROWS_WITH(rgbl::verify_loop(camera, k, map, id), Catch::Contains("current keyframe") && Catch::Contains("2 descriptors"));
 }

@@ -49,7 +49,7 @@ struct LoopVerification {
 // `camera` is the current keyframe's. `current` is a keyframe, possibly of another map (merging): only
 // its keypoints, descriptors and depths are used, not its pose or landmarks. `candidate` is a keyframe of
 // `map`. nullopt: not verified; `counts` (optional) says how far it got. Throws ConfigError on bad
-// options. Read-only on the map: the caller holds its lock (shared is enough).
+// options and on a current keyframe whose descriptors or depths do not match its keypoints. Read-only on the map: the caller holds its lock (shared is enough).
 std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const Keyframe& current, const Map& map,
                                             KeyframeId candidate, const LoopVerificationOptions& options = {},
                                             LoopVerificationCounts* counts = nullptr);
