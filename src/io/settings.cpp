@@ -11,8 +11,10 @@
 #include <exception>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <set>
 #include <string_view>
+#include <utility>
 
 namespace rgbl {
 namespace {
@@ -123,22 +125,41 @@ Settings read_settings(const std::filesystem::path& yaml) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
     throw ParseError(yaml, 0, "is empty (expected 'Key: value' settings)");
   }
-  // OpenCV 4.6's YAML parser loops forever on some lines starting with "---" (found by fuzz_settings:
-  // "----s\n----\nL"). A settings file is one document: allow a single plain "---" line, nothing else.
+  // OpenCV 4.6's YAML parser never returns on some malformed input, found by fuzz_settings:
+  // - lines starting with "---" ("----s\n----\nL"): a settings file is one document, so a single plain
+  //   "---" line is allowed and nothing else;
+  // - a key indented less than the first key (" t: 0\nL: -\na"): invalid YAML anyway (the first key
+  //   sets the top-level map's indentation), so it is refused with its line.
   {
     std::size_t line_no = 0, markers = 0, pos = 0;
+    std::optional<std::pair<std::size_t, std::size_t>> first_key;  // (indentation, line)
     while (pos < text.size()) {
       const std::size_t end = std::min(text.find('\n', pos), text.size());
       std::string_view line(text.data() + pos, end - pos);
       ++line_no;
+      pos = end + 1;
       if (line.starts_with("---")) {
         while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.remove_suffix(1);
         if (line != "---" || ++markers > 1) {
           throw ParseError(yaml, line_no, "expected 'Key: value' (a settings file is one YAML document; '---' "
                                           "may only start it)");
         }
+        continue;
       }
-      pos = end + 1;
+      const std::size_t indent = std::min(line.find_first_not_of(' '), line.size());
+      const std::string_view content = line.substr(indent);
+      if (content.find_first_not_of(" \t\r") == std::string_view::npos || content.starts_with('#') ||
+          (indent == 0 && content.starts_with('%'))) {
+        continue;  // blank, comment or directive
+      }
+      if (!first_key) {
+        first_key.emplace(indent, line_no);
+      } else if (indent < first_key->first) {
+        throw ParseError(yaml, line_no,
+                         fmt::format("expected 'Key: value' indented like the first key (line {}, {} spaces), "
+                                     "found {} spaces",
+                                     first_key->second, first_key->first, indent));
+      }
     }
   }
   if (!text.starts_with("%YAML")) text = "%YAML:1.0\n" + text;

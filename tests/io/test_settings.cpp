@@ -175,6 +175,12 @@ TEST_CASE("settings: input on which OpenCV's parser throws standard exceptions i
   // Found by fuzz/fuzz_settings: OpenCV 4.6's parser never returned on this (document markers).
   CHECK_THAT(error_of(tmp.write("markers.yaml", "----s\n----\nL")), Contains("markers.yaml:1: expected 'Key: value'"));
   CHECK_THAT(error_of(tmp.write("two.yaml", "---\na: 1\n---\nb: 2\n")), Contains("two.yaml:3:"));
+  // Found by fuzz/fuzz_settings: OpenCV 4.6's parser never returned on a key indented less than the first.
+  CHECK_THAT(error_of(tmp.write("dedent.yaml", " t:0\nL::-\na")), Contains("dedent.yaml:2: expected 'Key: value' indented"));
+  CHECK_THAT(error_of(tmp.write("dedent2.yaml", "  t: 0\n  # note\n L: -\na")),
+             Contains("dedent2.yaml:3:") && Contains("line 1, 2 spaces"));
+  // An indented top-level map is fine as long as every key keeps that indentation.
+  CHECK(rgbl::read_settings(tmp.write("indented.yaml", "# c\n  Camera.fps: 10.0\n\n  Camera.RGB: 1\n")).fps == 10.0);
   // One plain document start is fine.
   CHECK(rgbl::read_settings(tmp.write("one.yaml", "%YAML:1.0\n---\nCamera.fps: 10.0\n")).fps == 10.0);
 }
