@@ -6,15 +6,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
+#include <optional>
 
 namespace rgbl {
 
 void ScanContextOptions::validate() const {
-  require(rings >= 1, "scan_context.rings", ">= 1");
-  require(sectors >= 2, "scan_context.sectors", ">= 2");
+  // the upper bounds keep rings * sectors far from int overflow; finer grids have too few points per cell
+  require(rings >= 1 && rings <= 1000, "scan_context.rings", "in [1, 1000]");
+  require(sectors >= 2 && sectors <= 3600, "scan_context.sectors", "in [2, 3600]");
   require(min_range >= 0.0, "scan_context.min_range", ">= 0 m");
-  require(max_range > min_range, "scan_context.max_range", "> min_range");
+  require(max_range > min_range && std::isfinite(max_range), "scan_context.max_range", "finite and > min_range");
   require(std::isfinite(height_offset), "scan_context.height_offset", "a finite height in m");
 }
 
@@ -33,15 +36,21 @@ void ScanContext::update_ring_key() {
 ScanContext make_scan_context(PointCloudView scan, const ScanContextOptions& options) {
   options.validate();
   ScanContext context(options.rings, options.sectors);
-  const double ring_step = (options.max_range - options.min_range) / options.rings;
-  const double sector_step = 2.0 * M_PI / options.sectors;
+  // Ranges compared squared, so points outside the annulus cost no sqrt or atan2; sqrt, not hypot, whose
+  // overflow care buys nothing at LiDAR ranges and costs time in the hottest loop.
+  const double min_sq = options.min_range * options.min_range;
+  const double max_sq = options.max_range * options.max_range;
+  const double rings_per_m = options.rings / (options.max_range - options.min_range);
+  const double sectors_per_rad = options.sectors / (2.0 * std::numbers::pi);
   for (const LidarPoint& p : scan) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
-    const double range = std::hypot(static_cast<double>(p.x), static_cast<double>(p.y));
-    if (range < options.min_range || range >= options.max_range) continue;
-    const int ring = std::min(options.rings - 1, static_cast<int>((range - options.min_range) / ring_step));
-    const double azimuth = std::atan2(static_cast<double>(p.y), static_cast<double>(p.x));
-    const int sector = std::clamp(static_cast<int>(std::floor((azimuth + M_PI) / sector_step)), 0, options.sectors - 1);
+    const double x = p.x, y = p.y;
+    const double range_sq = x * x + y * y;
+    if (range_sq < min_sq || range_sq >= max_sq) continue;
+    const int ring =
+        std::min(options.rings - 1, static_cast<int>((std::sqrt(range_sq) - options.min_range) * rings_per_m));
+    int sector = static_cast<int>((std::atan2(y, x) + std::numbers::pi) * sectors_per_rad);
+    if (sector >= options.sectors) sector = 0;  // azimuth +pi is -pi: straight behind, sector 0
     const float height = std::max(0.0F, static_cast<float>(p.z + options.height_offset));
     float& c = context.cell(ring, sector);
     c = std::max(c, height);
@@ -50,49 +59,121 @@ ScanContext make_scan_context(PointCloudView scan, const ScanContextOptions& opt
   return context;
 }
 
-ScanContextMatch compare(const ScanContext& query, const ScanContext& candidate) {
+namespace {
+
+// Cells copied column by column with each column's norm: the shift search walks columns, and a cosine
+// is then one contiguous dot product. Doubles, so a column compared with itself gives 1 to ~1e-16.
+struct Columns {
+  int rings = 0, sectors = 0;
+  std::vector<double> values;  // sector-major
+  std::vector<double> norm;    // 0: the column holds no point
+  std::vector<double> key;     // the sector key: the column's mean over rings
+
+  explicit Columns(const ScanContext& c)
+      : rings(c.rings()), sectors(c.sectors()), values(static_cast<std::size_t>(rings * sectors)),
+        norm(static_cast<std::size_t>(sectors)), key(static_cast<std::size_t>(sectors)) {
+    for (int s = 0; s < sectors; ++s) {
+      double sum = 0.0, sum_sq = 0.0;
+      for (int r = 0; r < rings; ++r) {
+        const double v = c.cell(r, s);
+        values[static_cast<std::size_t>(s * rings + r)] = v;
+        sum += v;
+        sum_sq += v * v;
+      }
+      norm[static_cast<std::size_t>(s)] = std::sqrt(sum_sq);
+      key[static_cast<std::size_t>(s)] = sum / rings;
+    }
+  }
+  const double* column(int s) const { return values.data() + static_cast<std::ptrdiff_t>(s) * rings; }
+};
+
+void check_sizes(const ScanContext& query, const ScanContext& candidate) {
   if (query.rings() != candidate.rings() || query.sectors() != candidate.sectors()) {
     throw ConfigError("scan_context", fmt::format("descriptors of one size (query {}x{}, candidate {}x{})",
                                                   query.rings(), query.sectors(), candidate.rings(),
                                                   candidate.sectors()));
   }
-  const int rings = query.rings();
-  const int sectors = query.sectors();
-  // Column norms once; a column with norm 0 holds no point.
-  std::vector<double> norm_q(static_cast<std::size_t>(sectors), 0.0), norm_c(static_cast<std::size_t>(sectors), 0.0);
-  for (int s = 0; s < sectors; ++s) {
-    for (int r = 0; r < rings; ++r) {
-      norm_q[static_cast<std::size_t>(s)] += static_cast<double>(query.cell(r, s)) * query.cell(r, s);
-      norm_c[static_cast<std::size_t>(s)] += static_cast<double>(candidate.cell(r, s)) * candidate.cell(r, s);
-    }
-  }
-  for (auto& n : norm_q) n = std::sqrt(n);
-  for (auto& n : norm_c) n = std::sqrt(n);
+}
 
+// Mean (1 - cosine) over the columns occupied in both, query column s against candidate column
+// s + shift; nullopt when no column is occupied in both.
+std::optional<double> distance_at(const Columns& q, const Columns& c, int shift) {
+  double sum = 0.0;
+  int columns = 0;
+  for (int s = 0; s < q.sectors; ++s) {
+    const int t = s + shift < q.sectors ? s + shift : s + shift - q.sectors;
+    const double nq = q.norm[static_cast<std::size_t>(s)], nc = c.norm[static_cast<std::size_t>(t)];
+    if (nq == 0.0 || nc == 0.0) continue;
+    const double* a = q.column(s);
+    const double* b = c.column(t);
+    double dot = 0.0;
+    for (int r = 0; r < q.rings; ++r) dot += a[r] * b[r];
+    sum += 1.0 - dot / (nq * nc);
+    ++columns;
+  }
+  if (columns == 0) return std::nullopt;
+  return sum / columns;
+}
+
+// Best of the shifts marked in `search` (all when empty); the lowest shift wins a tie.
+ScanContextMatch best_shift(const Columns& q, const Columns& c, const std::vector<char>& search) {
   ScanContextMatch best;
-  for (int shift = 0; shift < sectors; ++shift) {
-    double sum = 0.0;
-    int columns = 0;
-    for (int s = 0; s < sectors; ++s) {
-      const int t = (s + shift) % sectors;
-      const double nq = norm_q[static_cast<std::size_t>(s)], nc = norm_c[static_cast<std::size_t>(t)];
-      if (nq == 0.0 || nc == 0.0) continue;
-      double dot = 0.0;
-      for (int r = 0; r < rings; ++r) dot += static_cast<double>(query.cell(r, s)) * candidate.cell(r, t);
-      sum += 1.0 - dot / (nq * nc);
-      ++columns;
-    }
-    if (columns == 0) continue;
-    const double distance = sum / columns;
-    if (distance < best.distance) {
-      best.distance = distance;
+  for (int shift = 0; shift < q.sectors; ++shift) {
+    if (!search.empty() && search[static_cast<std::size_t>(shift)] == 0) continue;
+    const std::optional<double> d = distance_at(q, c, shift);
+    if (d && *d < best.distance) {
+      best.distance = *d;
       best.sector_shift = shift;
     }
   }
   // shift k: query azimuth a sits where the candidate has a + k sectors
-  const int signed_shift = best.sector_shift > sectors / 2 ? best.sector_shift - sectors : best.sector_shift;
-  best.yaw = signed_shift * 2.0 * M_PI / sectors;
+  const int signed_shift = best.sector_shift > q.sectors / 2 ? best.sector_shift - q.sectors : best.sector_shift;
+  best.yaw = signed_shift * 2.0 * std::numbers::pi / q.sectors;
   return best;
+}
+
+constexpr int kKeyAlignments = 3;  // best sector-key alignments searched in full
+constexpr int kShiftRadius = 2;    // sectors searched either side of each: the keys blur a part-sector turn
+
+ScanContextMatch compare_coarse_to_fine(const Columns& q, const Columns& c) {
+  const int sectors = q.sectors;
+  std::vector<double> key_distance(static_cast<std::size_t>(sectors));
+  for (int shift = 0; shift < sectors; ++shift) {
+    double d = 0.0;
+    for (int s = 0; s < sectors; ++s) {
+      const int t = s + shift < sectors ? s + shift : s + shift - sectors;
+      d += std::abs(q.key[static_cast<std::size_t>(s)] - c.key[static_cast<std::size_t>(t)]);
+    }
+    key_distance[static_cast<std::size_t>(shift)] = d;
+  }
+  std::vector<int> order(static_cast<std::size_t>(sectors));
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return key_distance[static_cast<std::size_t>(a)] < key_distance[static_cast<std::size_t>(b)];
+  });
+  std::vector<char> search(static_cast<std::size_t>(sectors), 0);
+  const double best_key = key_distance[static_cast<std::size_t>(order.front())];
+  for (int i = 0; i < sectors; ++i) {
+    const int centre = order[static_cast<std::size_t>(i)];
+    // ties with the best are all kept: a symmetric scene must not hide the exact alignment
+    if (i >= kKeyAlignments && key_distance[static_cast<std::size_t>(centre)] > best_key) break;
+    for (int d = -kShiftRadius; d <= kShiftRadius; ++d) {
+      search[static_cast<std::size_t>(((centre + d) % sectors + sectors) % sectors)] = 1;
+    }
+  }
+  return best_shift(q, c, search);
+}
+
+}  // namespace
+
+ScanContextMatch compare(const ScanContext& query, const ScanContext& candidate) {
+  check_sizes(query, candidate);
+  return compare_coarse_to_fine(Columns(query), Columns(candidate));
+}
+
+ScanContextMatch compare_all_shifts(const ScanContext& query, const ScanContext& candidate) {
+  check_sizes(query, candidate);
+  return best_shift(Columns(query), Columns(candidate), {});
 }
 
 void ScanContextDatabase::add(std::size_t id, ScanContext context) {
@@ -116,9 +197,11 @@ std::vector<ScanContextDatabase::Candidate> ScanContextDatabase::query(const Sca
   std::partial_sort(by_key.begin(), by_key.begin() + static_cast<std::ptrdiff_t>(keep), by_key.end());
   std::vector<Candidate> out;
   out.reserve(keep);
+  const Columns query_columns(context);
   for (std::size_t k = 0; k < keep; ++k) {
     const Entry& e = entries_[by_key[k].second];
-    out.push_back(Candidate{e.id, compare(context, e.context)});
+    check_sizes(context, e.context);
+    out.push_back(Candidate{e.id, compare_coarse_to_fine(query_columns, Columns(e.context))});
   }
   std::stable_sort(out.begin(), out.end(),
                    [](const Candidate& a, const Candidate& b) { return a.match.distance < b.match.distance; });
