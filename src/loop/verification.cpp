@@ -89,6 +89,50 @@ Eigen::Isometry3d align(const std::vector<Match>& matches, const std::vector<std
   return T;
 }
 
+// Refine on reprojection (and depth where the keypoint has it) of every match; the optimiser
+// re-classifies outliers.
+PoseOptimizerResult refine(const PinholeCamera& camera, const Keyframe& current, const Map& map,
+                           const std::vector<Match>& matches, const Eigen::Isometry3d& T_cam_world,
+                           const LoopVerificationOptions& options) {
+  std::vector<PoseObservation> observations;
+  observations.reserve(matches.size());
+  for (const Match& m : matches) {
+    const auto k = static_cast<std::size_t>(m.keypoint);
+    PoseObservation o;
+    o.p_world = m.p_world;
+    o.pixel = Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y);
+    o.sigma_px = std::pow(map.options().scale_factor, current.keypoints[k].level);
+    o.depth = current.depth[k];
+    o.depth_sigma = k < current.depth_sigma.size() && current.depth_sigma[k] > 0.0F ? current.depth_sigma[k]
+                                                                                      : tolerance(m, options);
+    observations.push_back(o);
+  }
+  return optimize_pose(camera, T_cam_world, observations);
+}
+
+LoopVerification result(const Keyframe& current, const Keyframe& matched, KeyframeId candidate,
+                        const PoseOptimizerResult& refined, const LoopVerificationCounts& counts) {
+  LoopVerification v;
+  v.counts = counts;
+  v.T_cam_world = refined.T_cam_world;
+  v.constraint.current = current.id;
+  v.constraint.matched = candidate;
+  v.constraint.T_current_matched = refined.T_cam_world * matched.T_cam_world.inverse();
+  return v;
+}
+
+
+// Options valid and one descriptor and one depth per keypoint, else ConfigError.
+void check(const LoopVerificationOptions& options, const Keyframe& current) {
+  options.validate();
+  if (current.descriptors.size() != current.keypoints.size() || current.depth.size() != current.keypoints.size()) {
+    throw ConfigError("current keyframe", fmt::format("one descriptor and one depth per keypoint (has {} keypoints, {} "
+                                                      "descriptors, {} depths)",
+                                                      current.keypoints.size(), current.descriptors.size(),
+                                                      current.depth.size()));
+  }
+}
+
 }  // namespace
 
 void LoopVerificationOptions::validate() const {
@@ -99,19 +143,14 @@ void LoopVerificationOptions::validate() const {
           "min_tolerance > 0 m and relative_tolerance >= 0");
   require(min_ransac_inliers >= 3, "loop_verification.min_ransac_inliers", ">= 3");
   require(min_inliers >= 3, "loop_verification.min_inliers", ">= 3");
+  require(guided_radius_px > 0.0, "loop_verification.guided_radius_px", "> 0 px");
   require(min_inlier_ratio >= 0.0 && min_inlier_ratio <= 1.0, "loop_verification.min_inlier_ratio", "in [0, 1]");
 }
 
 std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const Keyframe& current, const Map& map,
                                             KeyframeId candidate, const LoopVerificationOptions& options,
                                             LoopVerificationCounts* counts) {
-  options.validate();
-  if (current.descriptors.size() != current.keypoints.size() || current.depth.size() != current.keypoints.size()) {
-    throw ConfigError("current keyframe", fmt::format("one descriptor and one depth per keypoint (has {} keypoints, {} "
-                                                      "descriptors, {} depths)",
-                                                      current.keypoints.size(), current.descriptors.size(),
-                                                      current.depth.size()));
-  }
+  check(options, current);
   LoopVerificationCounts scratch;
   LoopVerificationCounts& reached = counts != nullptr ? *counts : scratch;
   reached = {};
@@ -154,30 +193,67 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
   reached.ransac_inliers = count_agreeing(matches, best_T, options);
   if (reached.ransac_inliers < options.min_ransac_inliers) return std::nullopt;
 
-  // Refine on reprojection and depth of every match; the optimiser re-classifies outliers.
-  std::vector<PoseObservation> observations;
-  observations.reserve(n);
-  for (const Match& m : matches) {
-    const auto k = static_cast<std::size_t>(m.keypoint);
-    PoseObservation o;
-    o.p_world = m.p_world;
-    o.pixel = Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y);
-    o.sigma_px = std::pow(map.options().scale_factor, current.keypoints[k].level);
-    o.depth = current.depth[k];
-    o.depth_sigma = k < current.depth_sigma.size() && current.depth_sigma[k] > 0.0F ? current.depth_sigma[k]
-                                                                                      : tolerance(m, options);
-    observations.push_back(o);
-  }
-  const PoseOptimizerResult refined = optimize_pose(camera, best_T, observations);
+  const PoseOptimizerResult refined = refine(camera, current, map, matches, best_T, options);
   reached.inliers = refined.inliers;
   if (reached.inliers < options.min_inliers || reached.inliers < options.min_inlier_ratio * reached.matches) return std::nullopt;
-  LoopVerification v;
-  v.counts = reached;
-  v.T_cam_world = refined.T_cam_world;
-  v.constraint.current = current.id;
-  v.constraint.matched = candidate;
-  v.constraint.T_current_matched = refined.T_cam_world * matched->T_cam_world.inverse();
-  return v;
+  return result(current, *matched, candidate, refined, reached);
 }
+
+std::optional<LoopVerification> verify_loop_guided(const PinholeCamera& camera, const Keyframe& current, const Map& map,
+                                                   KeyframeId candidate, const Eigen::Isometry3d& T_cam_world_guess,
+                                                   const LoopVerificationOptions& options,
+                                                   LoopVerificationCounts* counts) {
+  check(options, current);
+  LoopVerificationCounts scratch;
+  LoopVerificationCounts& reached = counts != nullptr ? *counts : scratch;
+  reached = {};
+  const Keyframe* matched = map.keyframe(candidate);
+  if (matched == nullptr) return std::nullopt;
+  std::vector<KeyframeId> around{candidate};
+  for (const KeyframeId id : map.best_covisible(candidate, options.neighbours)) around.push_back(id);
+  // Each region landmark seen from the guess is matched to the closest-descriptor keypoint within the
+  // search radius (scaled by the keypoint's pyramid level); each keypoint keeps its best landmark.
+  std::map<int, std::pair<int, int>> best_of_keypoint;  // keypoint -> (landmark, distance)
+  for (const LandmarkId id : map.landmarks_seen_by(around)) {
+    const Landmark& landmark = *map.landmark(id);
+    const Eigen::Vector3d p_cam = T_cam_world_guess * landmark.position;
+    if (p_cam.z() <= 0.0) continue;
+    const auto px = camera.project(p_cam);
+    if (!px || !camera.in_image(*px)) continue;
+    int best = options.max_hamming + 1, best_keypoint = -1;
+    for (std::size_t k = 0; k < current.keypoints.size(); ++k) {
+      const double radius = options.guided_radius_px * std::pow(map.options().scale_factor, current.keypoints[k].level);
+      const double dx = current.keypoints[k].x - px->x(), dy = current.keypoints[k].y - px->y();
+      if (dx * dx + dy * dy > radius * radius) continue;
+      const int d = hamming_distance(current.descriptors[k], landmark.descriptor);
+      if (d < best) {
+        best = d;
+        best_keypoint = static_cast<int>(k);
+      }
+    }
+    if (best_keypoint < 0) continue;
+    const auto it = best_of_keypoint.find(best_keypoint);
+    if (it == best_of_keypoint.end() || best < it->second.second) best_of_keypoint[best_keypoint] = {id.value, best};
+  }
+  std::vector<Match> matches;
+  matches.reserve(best_of_keypoint.size());
+  for (const auto& [keypoint, lm] : best_of_keypoint) {
+    const auto k = static_cast<std::size_t>(keypoint);
+    Match m;
+    m.keypoint = keypoint;
+    m.p_cam = current.depth[k] > 0.0F
+                  ? camera.unproject(Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y), current.depth[k])
+                  : Eigen::Vector3d::Zero();
+    m.p_world = map.landmark(LandmarkId{lm.first})->position;
+    matches.push_back(m);
+  }
+  reached.matches = static_cast<int>(matches.size());
+  if (reached.matches < options.min_inliers) return std::nullopt;
+  const PoseOptimizerResult refined = refine(camera, current, map, matches, T_cam_world_guess, options);
+  reached.inliers = refined.inliers;
+  if (reached.inliers < options.min_inliers || reached.inliers < options.min_inlier_ratio * reached.matches) return std::nullopt;
+  return result(current, *matched, candidate, refined, reached);
+}
+
 
 }  // namespace rgbl

@@ -28,6 +28,9 @@ struct LoopVerificationOptions {
   int min_ransac_inliers = 30;
   int min_inliers = 40;         // after pose refinement (ORB-SLAM asks 40 for a loop, with a Sim3)
   double min_inlier_ratio = 0.3;  // of the matches: a few agreeing among many random ones is chance
+  // verify_loop_guided: landmarks are searched this far from where the guess projects them, times the
+  // keypoint's pyramid scale (ORB-SLAM's projection searches use 7.5-15 px at level 0).
+  double guided_radius_px = 10.0;
 
   void validate() const;
 };
@@ -53,5 +56,16 @@ struct LoopVerification {
 std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const Keyframe& current, const Map& map,
                                             KeyframeId candidate, const LoopVerificationOptions& options = {},
                                             LoopVerificationCounts* counts = nullptr);
+
+// The same decision from a pose guess instead of descriptor matching alone: the landmarks of the
+// candidate and its neighbours are projected with T_cam_world_guess (the current keyframe in the
+// candidate's map) and matched to keypoints near them (max_hamming, no ratio test: the guess
+// disambiguates), then the pose is refined from the guess (keypoints without depth count by
+// reprojection). For a keyframe next to one already verified, whose pose in the candidate's map
+// follows from it. `counts.ransac_inliers` stays 0 (no RANSAC).
+std::optional<LoopVerification> verify_loop_guided(const PinholeCamera& camera, const Keyframe& current, const Map& map,
+                                                   KeyframeId candidate, const Eigen::Isometry3d& T_cam_world_guess,
+                                                   const LoopVerificationOptions& options = {},
+                                                   LoopVerificationCounts* counts = nullptr);
 
 }  // namespace rgbl
