@@ -167,13 +167,13 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
   {
     std::ofstream csv(out_dir / "timing.csv");
     csv << "frame,timestamp,state,keyframe,keypoints,keypoints_with_depth,inliers,io_wait_ms,depth_ms,"
-           "extraction_ms,tracking_ms,mapping_ms,total_ms\n";
+           "extraction_ms,tracking_ms,mapping_ms,loop_ms,total_ms\n";
     for (const auto& r : records) {
       const auto& t = r.result.timing;
-      csv << fmt::format("{},{:.6f},{},{},{},{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f}\n", r.result.frame_index,
-                         r.result.timestamp, to_string(r.result.state), r.result.keyframe ? 1 : 0,
+      csv << fmt::format("{},{:.6f},{},{},{},{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f}\n",
+                         r.result.frame_index, r.result.timestamp, to_string(r.result.state), r.result.keyframe ? 1 : 0,
                          r.result.keypoints, r.result.keypoints_with_depth, r.result.inliers, r.io_wait_ms,
-                         t.depth_ms, t.extraction_ms, t.tracking_ms, t.mapping_ms, t.total_ms);
+                         t.depth_ms, t.extraction_ms, t.tracking_ms, t.mapping_ms, t.loop_ms, t.total_ms);
     }
     if (!csv) throw Error(fmt::format("{}: cannot write", (out_dir / "timing.csv").string()));
   }
@@ -246,13 +246,14 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
     write_ply(out_dir / "map.ply", points, {}, cameras);
   }
 
-  std::vector<double> depth_ms, extraction_ms, tracking_ms, mapping_ms, total_ms, front_ms, io_ms;
+  std::vector<double> depth_ms, extraction_ms, tracking_ms, mapping_ms, loop_ms, total_ms, front_ms, io_ms;
   for (const auto& r : records) {
     const auto& t = r.result.timing;
     depth_ms.push_back(t.depth_ms);
     extraction_ms.push_back(t.extraction_ms);
     tracking_ms.push_back(t.tracking_ms);
     mapping_ms.push_back(t.mapping_ms);
+    loop_ms.push_back(t.loop_ms);
     total_ms.push_back(t.total_ms);
     front_ms.push_back(t.depth_ms + t.extraction_ms + t.tracking_ms);
     io_ms.push_back(r.io_wait_ms);
@@ -284,6 +285,22 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
   // Steps beyond a vehicle's reach: taken on strong evidence, or rejected (the frame placed at the prediction).
   const std::string jump_frames = frame_list([](const TrackResult& r) { return r.jump; });
   const std::string rejected_frames = frame_list([](const TrackResult& r) { return r.step_rejected; });
+  // Loops closed: where, against what, how far the map moved there, and the cost.
+  std::string loop_closures;
+  std::vector<const LoopClosure*> closures;
+  for (const auto& r : records) {
+    if (!r.result.loop_closure) continue;
+    const LoopClosure& c = *r.result.loop_closure;
+    closures.push_back(&c);
+    loop_closures += fmt::format(
+        "{}\n    {{\"frame\": {}, \"matched_frame\": {}, \"place_distance\": {}, \"inliers\": {}, "
+        "\"correction_m\": {}, \"correction_deg\": {}, \"loop_error_before_m\": {}, \"loop_error_after_m\": {}, "
+        "\"time_ms\": {}}}",
+        loop_closures.empty() ? "" : ",", c.frame_index, c.matched_frame_index, json_number(c.place_distance), c.inliers,
+        json_number(c.correction_m), json_number(c.correction_deg), json_number(c.correction.loop_error_before_m),
+        json_number(c.correction.loop_error_after_m), json_number(c.time_ms));
+  }
+  if (!loop_closures.empty()) loop_closures += "\n  ";
   {
     const auto file = out_dir / "summary.json";
     std::ofstream json(file);
@@ -300,11 +317,14 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
                         new_map_frames, jump_frames, rejected_frames,
                         out.min_inliers_ok ? std::to_string(*out.min_inliers_ok) : "null", out.keyframes,
                         out.landmarks)
+         << fmt::format("  \"loop_closing\": {},\n  \"loop_closures\": [{}],\n",
+                        system_options.loop_closing.enabled && !threaded ? "true" : "false", loop_closures)
          << fmt::format("  \"threaded_mapping\": {},\n  \"wall_s\": {},\n", threaded ? "true" : "false",
                         json_number(out.wall_s))
          << "  \"stage_ms\": {\n    " << stage_json("io_wait", stats(io_ms)) << ",\n    "
          << stage_json("depth", depth) << ",\n    " << stage_json("extraction", extraction)
          << ",\n    " << stage_json("tracking", tracking) << ",\n    " << stage_json("mapping", mapping)
+         << ",\n    " << stage_json("loop", stats(loop_ms))
          << ",\n    " << stage_json("depth_extraction_tracking", front) << ",\n    " << stage_json("total", total)
          << "\n  },\n"
          << "  \"metrics\": " << metrics_json << "\n}\n";
@@ -317,6 +337,10 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
              out.weak, out.lost, out.not_initialised, out.keyframes, out.landmarks);
   if (!jump_frames.empty()) fmt::print("  steps beyond a vehicle's reach taken at frame(s) {}\n", jump_frames);
   if (!new_map_frames.empty()) fmt::print("  lost beyond relocalisation: new map started at frame(s) {}\n", new_map_frames);
+  for (const LoopClosure* c : closures) {
+    fmt::print("  loop closed at frame {} with frame {}: map moved {:.2f} m / {:.2f} deg there, {:.0f} ms\n",
+               c->frame_index, c->matched_frame_index, c->correction_m, c->correction_deg, c->time_ms);
+  }
   fmt::print("  per frame (median / p95 ms): depth {:.2f} / {:.2f}, extraction {:.2f} / {:.2f}, tracking {:.2f} / "
              "{:.2f}, mapping {:.2f} / {:.2f}\n",
              depth.median, depth.p95, extraction.median, extraction.p95, tracking.median, tracking.p95,
@@ -341,12 +365,16 @@ Command add_run_command(CLI::App& parent) {
   auto options = std::make_shared<InputOptions>();
   auto out_dir = std::make_shared<std::string>("rgbl_output");
   auto threaded = std::make_shared<bool>(false);
+  auto no_loop_closing = std::make_shared<bool>(false);
   add_input_options(*app, *options);
   app->add_option("--out", *out_dir, "Output folder")->capture_default_str();
   app->add_flag("--threaded", *threaded, "Local mapping in its own thread (default: inline, bit-for-bit reproducible)");
-  return {app, [options, out_dir, threaded, app] {
+  app->add_flag("--no-loop-closing", *no_loop_closing,
+                "Do not close loops (default: closed inline on keyframes with a LiDAR scan; off with --threaded)");
+  return {app, [options, out_dir, threaded, no_loop_closing, app] {
             remove_previous_outputs(*out_dir);
             Pipeline pipeline = make_pipeline(*options);
+            if (*no_loop_closing) pipeline.system.loop_closing.enabled = false;
             const bool quiet = app->get_parent()->get_option("--quiet")->as<bool>();
             for (const auto& note : pipeline.notes) fmt::print(stderr, "note: {}\n", note);
             run_pipeline(pipeline, *out_dir, *threaded, quiet);

@@ -21,6 +21,7 @@ void SystemOptions::validate() const {
   mapping.validate();
   depth_noise.validate();
   map.validate();
+  loop_closing.validate();
 }
 
 namespace {
@@ -41,6 +42,7 @@ struct System::Impl {
   Map map;
   Tracker tracker;
   LocalMapper mapper;
+  LoopCloser closer;
   std::vector<FrameRecord> records;
   std::vector<Eigen::Vector2f> pixels;
   std::vector<KeypointDepth> depths;
@@ -55,7 +57,10 @@ struct System::Impl {
 
   Impl(SystemOptions o, CameraCalibration c, std::unique_ptr<DepthSource> d, FeatureExtractor e)
       : options(o), calibration(c), depth(std::move(d)), extractor(std::move(e)), map(o.map),
-        tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping) {
+        tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping), closer(c.camera, o.loop_closing) {
+    if (options.threaded_mapping && options.loop_closing.enabled) {
+      logger()->warn("loop closing runs inline only for now: off with threaded mapping");
+    }
     if (options.threaded_mapping) thread = std::thread([this] { run_mapping(); });
   }
 
@@ -190,6 +195,26 @@ TrackResult System::track(const SensorFrame& sensor) {
     }
   }
   result.timing.mapping_ms = stage.lap_ms();
+
+  // The map's first keyframe is a place too (a loop often ends where the drive started).
+  const KeyframeId loop_keyframe = outcome.initialised_now ? s.tracker.reference_keyframe() : new_keyframe;
+  if (loop_keyframe.valid() && !s.options.threaded_mapping && s.options.loop_closing.enabled) {
+    std::optional<Eigen::Isometry3d> T_ref_world_before;
+    {
+      std::shared_lock lock(s.map.mutex());
+      T_ref_world_before = s.map.keyframe_pose(s.tracker.reference_keyframe());
+    }
+    LoopCloserStep step = s.closer.process(s.map, loop_keyframe, sensor.scan);
+    if (step.closure && T_ref_world_before) {
+      s.tracker.follow_map_correction(*T_ref_world_before);
+      std::shared_lock lock(s.map.mutex());
+      // this frame is the reference keyframe: it moves with it
+      frame.T_cam_world = frame.T_cam_world * T_ref_world_before->inverse() *
+                          *s.map.keyframe_pose(s.tracker.reference_keyframe());
+    }
+    result.loop_closure = std::move(step.closure);
+  }
+  result.timing.loop_ms = stage.lap_ms();
 
   result.state = outcome.state;
   result.keyframe = outcome.initialised_now || new_keyframe.valid();

@@ -1,55 +1,19 @@
 #include "rgbl/loop/verification.hpp"
 
 #include "rgbl/core/error.hpp"
-#include "rgbl/depth/sources.hpp"
-#include "rgbl/features/orb.hpp"
 #include "rgbl/geometry/se3.hpp"
 #include "rgbl/io/sequence.hpp"
-#include "rgbl/tracking/system.hpp"
+#include "mapped_drive.hpp"
 #include "support/data.hpp"
 
 #include <catch2/catch.hpp>
 
-#include <memory>
 
-namespace {
-
-// Tracks the first `frames` frames of a real KITTI drive with default settings; the map is the result.
-struct Mapped {
-  rgbl::CameraCalibration calibration;
-  std::unique_ptr<rgbl::System> system;
-};
-
-Mapped map_drive(const std::unique_ptr<rgbl::Sequence>& sequence, std::size_t frames) {
-  Mapped m;
-  m.calibration = sequence->calibration().camera(0);
-  rgbl::DepthSourceSettings depth;
-  depth.calibration = m.calibration;
-  auto orb = std::make_shared<rgbl::OrbExtractor>();
-  m.system = std::make_unique<rgbl::System>(
-      rgbl::SystemOptions{}, m.calibration, rgbl::make_lidar_source(depth),
-      [orb](const cv::Mat& gray, std::vector<rgbl::Keypoint>& kps, std::vector<rgbl::Descriptor>& desc) {
-        orb->extract(gray, kps, desc);
-      });
-  for (std::size_t i = 0; i < std::min(frames, sequence->size()); ++i) {
-    const rgbl::FrameInput input = sequence->load(i);
-    rgbl::SensorFrame frame;
-    frame.index = i;
-    frame.timestamp = input.timestamp;
-    frame.image = input.images[0];
-    frame.scan = input.scan;
-    m.system->track(frame);
-  }
-  m.system->finish();
-  return m;
-}
-
-}  // namespace
 
 TEST_CASE("loop verification measures the relative pose of two keyframes of one real drive") {
   const auto dir = rgbl::test::kitti_seq04();
   if (!dir) return;
-  const Mapped m = map_drive(rgbl::open_kitti_odometry(*dir), 30);
+  const rgbl::test::Mapped m = rgbl::test::map_drive(rgbl::open_kitti_odometry(*dir), 30);
   const rgbl::Map& map = m.system->map();
   const auto ids = map.keyframe_ids();
   REQUIRE(ids.size() >= 6);
@@ -79,8 +43,8 @@ TEST_CASE("loop verification rejects every keyframe of another drive") {
   const auto seq04 = rgbl::test::kitti_seq04();
   const auto raw = rgbl::test::find_data("kitti/raw/2011_09_26/2011_09_26_drive_0009_sync");
   if (!seq04 || !raw) return;
-  const Mapped rural = map_drive(rgbl::open_kitti_odometry(*seq04), 30);
-  const Mapped city = map_drive(rgbl::open_kitti_raw(*raw), 10);
+  const rgbl::test::Mapped rural = rgbl::test::map_drive(rgbl::open_kitti_odometry(*seq04), 30);
+  const rgbl::test::Mapped city = rgbl::test::map_drive(rgbl::open_kitti_raw(*raw), 10);
   const rgbl::Map& rural_map = rural.system->map();
   const rgbl::Map& city_map = city.system->map();
   // The margin of the geometry alone: with every keypoint matched to its nearest landmark (no distance

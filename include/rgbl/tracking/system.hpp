@@ -5,6 +5,7 @@
 #include "rgbl/backend/depth_noise.hpp"
 #include "rgbl/depth/depth_source.hpp"
 #include "rgbl/geometry/calibration.hpp"
+#include "rgbl/loop/loop_closer.hpp"
 #include "rgbl/map/map.hpp"
 #include "rgbl/tracking/frame.hpp"
 #include "rgbl/tracking/options.hpp"
@@ -14,6 +15,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace rgbl {
@@ -23,6 +25,9 @@ struct SystemOptions {
   LocalMappingOptions mapping;
   DepthNoiseModel depth_noise;
   MapOptions map;
+  // Loop closing after local mapping on every keyframe with a LiDAR scan (inline only for now: with
+  // threaded_mapping it is off, and a warning says so).
+  LoopClosingOptions loop_closing;
   // false: local mapping runs inside track() and the same input gives a bit-identical trajectory.
   bool threaded_mapping = false;
   // Motion compensation of LiDAR depth: a spinning LiDAR measures a point at azimuth a (0 = ahead,
@@ -44,6 +49,7 @@ struct StageTiming {
   double extraction_ms = 0.0;
   double tracking_ms = 0.0;
   double mapping_ms = 0.0;
+  double loop_ms = 0.0;  // loop detection, verification and correction (keyframes only)
   double total_ms = 0.0;
 };
 
@@ -59,6 +65,7 @@ struct TrackResult {
   bool step_rejected = false;  // a step beyond a vehicle's reach on weak evidence: weak, at the prediction
   int inliers = 0;           // local-map inliers (ok needs 30, 50 after a relocalisation)
   int keypoints = 0, keypoints_with_depth = 0;
+  std::optional<LoopClosure> loop_closure;  // a loop closed on this frame: the map was corrected
   StageTiming timing;
 };
 

@@ -38,6 +38,10 @@ class Tracker {
   // Adds the frame as a keyframe to the map (taking the map lock) and makes it the reference.
   KeyframeId make_keyframe(const Frame& frame);
 
+  // The map was corrected (a loop closed): the reference keyframe, which was at T_ref_world_before,
+  // moved, and the last frames move with it so that the next prediction lands on the corrected map.
+  void follow_map_correction(const Eigen::Isometry3d& T_ref_world_before);
+
   TrackState state() const { return state_; }
   KeyframeId reference_keyframe() const { return reference_; }
   // Constant-velocity motion T_cur_last of the last tracked frame pair, if any.

@@ -1,0 +1,95 @@
+#pragma once
+// Loop closing, one keyframe at a time: a place is recognised from the keyframe's LiDAR scan (Scan
+// Context, no training), the candidates are verified geometrically with metric depth, a loop is
+// accepted only when consecutive keyframes verify it, and the map is then corrected by pose-graph
+// optimisation over the essential graph (keyframes and landmarks move together; frames tracked
+// against a keyframe follow it).
+//
+// Not here yet (issue 14): a bag of words for depth sources without a scan, landmark fusion across the
+// loop, the global bundle adjustment, map merging, a thread of its own.
+
+#include "rgbl/backend/loop_correction.hpp"
+#include "rgbl/geometry/camera.hpp"
+#include "rgbl/geometry/point_cloud.hpp"
+#include "rgbl/loop/verification.hpp"
+#include "rgbl/map/map.hpp"
+#include "rgbl/place/scan_context.hpp"
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+namespace rgbl {
+
+struct LoopClosingOptions {
+  bool enabled = true;
+  ScanContextOptions scan_context;
+  // Scan Context distance (0 same, 1 unrelated) below which a place is a candidate. On real sequence 04
+  // consecutive scans (1.35 m) score at most 0.20 and scans >= 34 m apart at least 0.50; the same scan
+  // turned by half a sector scores 0.175. Verification, not this bound, decides.
+  double max_place_distance = 0.35;
+  std::size_t ring_key_neighbours = 10;  // places compared in full per query
+  std::size_t max_candidates = 3;        // best places verified per keyframe
+  // Candidates are keyframes at least this many keyframes older than the query and not covisible with
+  // it: a recent keyframe is the local map's business, not a loop's.
+  int min_keyframe_gap = 10;
+  // Consecutive keyframes (this one and those before it) that must each verify the loop (ORB-SLAM: 3),
+  // and agree on it: their loop-measured poses relative to each other within these of the map's.
+  int consistent_keyframes = 3;
+  double consistency_tolerance_m = 0.2;
+  double consistency_tolerance_deg = 1.0;
+  // A verified loop changes the map only when the map disagrees with it by more than this: about 5x the
+  // verification's precision measured on real data (2.2 cm, 0.5 deg at 16 m). Below, it is recorded as
+  // confirming the map.
+  double min_correction_m = 0.1;
+  double min_correction_deg = 0.5;
+  LoopVerificationOptions verification;
+  LoopCorrectionOptions correction;
+
+  void validate() const;
+};
+
+// One closure: the map corrected through a loop.
+struct LoopClosure {
+  std::size_t frame_index = 0;          // of the keyframe that closed it
+  std::size_t matched_frame_index = 0;  // of the older keyframe it matched
+  KeyframeId current, matched;
+  double place_distance = 0.0;          // Scan Context distance of the match
+  int inliers = 0;                      // of the verification
+  double correction_m = 0.0;            // how far the current keyframe moved
+  double correction_deg = 0.0;          // and turned
+  double time_ms = 0.0;                 // detection, verification and correction of this keyframe
+  LoopCorrectionResult correction;
+};
+
+// What one keyframe did in the loop closer (also when nothing was closed).
+struct LoopCloserStep {
+  int candidates = 0;      // places below max_place_distance that were verified
+  int verified = 0;        // of those, verified geometrically
+  bool consistent = false; // a loop verified by consistent_keyframes consecutive keyframes that agree
+  double time_ms = 0.0;
+  std::optional<LoopClosure> closure;
+};
+
+class LoopCloser {
+ public:
+  LoopCloser(const PinholeCamera& camera, LoopClosingOptions options);
+
+  // Call once per new keyframe, in order, after local mapping has processed it. `scan` is the
+  // keyframe's LiDAR scan (empty: no place recognition for it). Takes the map's lock itself: shared
+  // while detecting, exclusive while correcting.
+  LoopCloserStep process(Map& map, KeyframeId keyframe, PointCloudView scan);
+
+  // Every loop the map has been corrected with (kept: later corrections must respect earlier loops).
+  const std::vector<LoopConstraint>& loops() const { return loops_; }
+  const LoopClosingOptions& options() const { return options_; }
+
+ private:
+  PinholeCamera camera_;
+  LoopClosingOptions options_;
+  ScanContextDatabase places_;
+  std::vector<LoopConstraint> loops_;
+  std::vector<KeyframeId> recent_;  // the latest keyframes processed, oldest first
+};
+
+}  // namespace rgbl

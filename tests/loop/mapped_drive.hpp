@@ -1,0 +1,46 @@
+#pragma once
+// A real drive tracked with default settings for the loop tests: the map is the result.
+
+#include "rgbl/depth/sources.hpp"
+#include "rgbl/features/orb.hpp"
+#include "rgbl/io/sequence.hpp"
+#include "rgbl/tracking/system.hpp"
+
+#include <algorithm>
+#include <memory>
+#include <vector>
+
+namespace rgbl::test {
+
+struct Mapped {
+  CameraCalibration calibration;
+  std::unique_ptr<System> system;
+  std::vector<TrackResult> results;
+};
+
+// Tracks the first `frames` frames of `sequence` (camera 0, LiDAR depth).
+inline Mapped map_drive(const std::unique_ptr<Sequence>& sequence, std::size_t frames,
+                        const SystemOptions& options = {}) {
+  Mapped m;
+  m.calibration = sequence->calibration().camera(0);
+  DepthSourceSettings depth;
+  depth.calibration = m.calibration;
+  auto orb = std::make_shared<OrbExtractor>();
+  m.system = std::make_unique<System>(options, m.calibration, make_lidar_source(depth),
+                                      [orb](const cv::Mat& gray, std::vector<Keypoint>& kps, std::vector<Descriptor>& desc) {
+                                        orb->extract(gray, kps, desc);
+                                      });
+  for (std::size_t i = 0; i < std::min(frames, sequence->size()); ++i) {
+    const FrameInput input = sequence->load(i);
+    SensorFrame frame;
+    frame.index = i;
+    frame.timestamp = input.timestamp;
+    frame.image = input.images[0];
+    frame.scan = input.scan;
+    m.results.push_back(m.system->track(frame));
+  }
+  m.system->finish();
+  return m;
+}
+
+}  // namespace rgbl::test
