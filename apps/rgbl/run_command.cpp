@@ -318,7 +318,7 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
                         out.min_inliers_ok ? std::to_string(*out.min_inliers_ok) : "null", out.keyframes,
                         out.landmarks)
          << fmt::format("  \"loop_closing\": {},\n  \"loop_closures\": [{}],\n",
-                        system_options.loop_closing.enabled && !threaded ? "true" : "false", loop_closures)
+                        system.loop_closing() ? "true" : "false", loop_closures)
          << fmt::format("  \"threaded_mapping\": {},\n  \"wall_s\": {},\n", threaded ? "true" : "false",
                         json_number(out.wall_s))
          << "  \"stage_ms\": {\n    " << stage_json("io_wait", stats(io_ms)) << ",\n    "

@@ -3,6 +3,7 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/log.hpp"
 #include "rgbl/core/timer.hpp"
+#include "rgbl/geometry/se3.hpp"
 
 #include <Eigen/Geometry>
 
@@ -11,6 +12,8 @@
 #include <mutex>
 #include <numbers>
 #include <shared_mutex>
+#include <span>
+#include <unordered_map>
 #include <utility>
 
 namespace rgbl {
@@ -33,23 +36,83 @@ void LoopClosingOptions::validate() const {
 
 namespace {
 
-// The spanning-tree root of a keyframe: keyframes of one map share it; a map started after a loss has
-// its own (a loop across two maps is a merge, which needs more than a pose graph).
-KeyframeId root_of(const Map& map, KeyframeId id) {
-  for (std::size_t steps = 0; steps <= map.keyframe_count(); ++steps) {
-    const Keyframe* k = map.keyframe(id);
-    if (k == nullptr || !k->parent.valid()) return id;
-    id = k->parent;
+// Spanning-tree roots, memoised for one query: keyframes of one map share the root, a map started
+// after a loss has its own (a loop across two maps is a merge, which needs more than a pose graph).
+// Each keyframe is walked once per query, however many candidates ask.
+class Roots {
+ public:
+  explicit Roots(const Map& map) : map_(map) {}
+
+  KeyframeId operator()(KeyframeId id) {
+    std::vector<int> path;
+    KeyframeId root = id;
+    // bounded: a cycle (never in a tree) ends the walk rather than looping forever
+    for (std::size_t steps = 0; steps <= map_.keyframe_count(); ++steps) {
+      if (const auto known = known_.find(root.value); known != known_.end()) {
+        root = known->second;
+        break;
+      }
+      const Keyframe* k = map_.keyframe(root);
+      if (k == nullptr || !k->parent.valid()) break;
+      path.push_back(root.value);
+      root = k->parent;
+    }
+    for (const int v : path) known_[v] = root;
+    return root;
   }
-  return id;  // unreachable for a tree; a cycle would end here rather than loop forever
-}
+
+ private:
+  const Map& map_;
+  std::unordered_map<int, KeyframeId> known_;
+};
 
 struct Verified {
   LoopVerification verification;
   double place_distance = 0.0;
 };
 
-double angle_deg(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180.0 / std::numbers::pi; }
+// How far camera pose b is from a: centre distance and rotation angle.
+struct PoseChange {
+  double m = 0.0, deg = 0.0;
+};
+PoseChange pose_change(const Eigen::Isometry3d& T_cam_world_a, const Eigen::Isometry3d& T_cam_world_b) {
+  return {(T_cam_world_b.inverse().translation() - T_cam_world_a.inverse().translation()).norm(),
+          rotation_angle(T_cam_world_b.linear() * T_cam_world_a.linear().transpose()) * 180.0 / std::numbers::pi};
+}
+
+// The loop must hold for the keyframes before `current` too (ORB-SLAM3 checks covisible keyframes
+// already in the map rather than waiting for new ones, which a loop ending where the drive ends never
+// brings): each verifies against the same matched keyframe by a guided search from the pose the loop
+// implies for it, and its measured pose relative to `current` agrees with the map's, which odometry
+// knows to centimetres over a few keyframes. Their loop constraints, or nullopt.
+std::optional<std::vector<LoopConstraint>> confirm(const PinholeCamera& camera, const LoopClosingOptions& options,
+                                                   const Map& map, const Keyframe& current, const Verified& loop,
+                                                   std::span<const KeyframeId> previous) {
+  const Eigen::Isometry3d& T_cur_world_loop = loop.verification.T_cam_world;
+  const KeyframeId matched = loop.verification.constraint.matched;
+  std::vector<LoopConstraint> constraints;
+  for (const KeyframeId id : previous) {
+    const Keyframe& k = *map.keyframe(id);
+    const Eigen::Isometry3d T_k_cur_map = k.T_cam_world * current.T_cam_world.inverse();
+    LoopVerificationCounts counts;
+    const auto again =
+        verify_loop_guided(camera, k, map, matched, T_k_cur_map * T_cur_world_loop, options.verification, &counts);
+    if (!again) {
+      logger()->debug("loop: keyframe {} verified keyframe {} but keyframe {} does not ({} matches, {} inliers)",
+                      current.id.value, matched.value, id.value, counts.matches, counts.inliers);
+      return std::nullopt;
+    }
+    // T_k_cur measured through the loop against the map's: equal when both are right
+    const PoseChange disagreement = pose_change(T_k_cur_map, again->T_cam_world * T_cur_world_loop.inverse());
+    if (disagreement.m > options.consistency_tolerance_m || disagreement.deg > options.consistency_tolerance_deg) {
+      logger()->debug("loop: keyframe {} and {} disagree on the loop by {:.3f} m, {:.2f} deg", current.id.value,
+                      id.value, disagreement.m, disagreement.deg);
+      return std::nullopt;
+    }
+    constraints.push_back(again->constraint);
+  }
+  return constraints;
+}
 
 }  // namespace
 
@@ -58,39 +121,39 @@ LoopCloser::LoopCloser(const PinholeCamera& camera, LoopClosingOptions options)
   options_.validate();
 }
 
+void LoopCloser::remember(KeyframeId keyframe) {
+  recent_.push_back(keyframe);
+  if (std::cmp_greater(recent_.size(), options_.consistent_keyframes)) recent_.erase(recent_.begin());
+}
+
 LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView scan) {
   LoopCloserStep step;
   if (!options_.enabled) return step;
   const Stopwatch watch;
-  if (scan.empty()) {
-    recent_.push_back(keyframe);  // still a keyframe whose verification later loops may ask for
-    if (recent_.size() > static_cast<std::size_t>(options_.consistent_keyframes)) recent_.erase(recent_.begin());
+  const auto done = [&] {
     step.time_ms = watch.elapsed_ms();
     return step;
+  };
+  if (scan.empty()) {
+    remember(keyframe);  // no place to recognise, but later loops may ask it to confirm
+    return done();
   }
   ScanContext context = make_scan_context(scan, options_.scan_context);
 
   std::optional<Verified> best;
-  std::vector<LoopConstraint> consistent;  // the earlier keyframes' verifications of the same loop
+  std::vector<LoopConstraint> confirmed;  // the earlier keyframes' verifications of the same loop
   {
     std::shared_lock lock(map.mutex());
     const Keyframe* current = map.keyframe(keyframe);
-    if (current == nullptr) {
-      step.time_ms = watch.elapsed_ms();
-      return step;
-    }
-    const KeyframeId root = root_of(map, keyframe);
+    if (current == nullptr) return done();
+    Roots roots(map);
+    const KeyframeId root = roots(keyframe);
     const auto allowed = [&](std::size_t id) {
       const KeyframeId candidate{static_cast<int>(id)};
       return candidate.value <= keyframe.value - options_.min_keyframe_gap && map.keyframe(candidate) != nullptr &&
-             !current->covisibility.contains(candidate) && root_of(map, candidate) == root;
+             !current->covisibility.contains(candidate) && roots(candidate) == root;
     };
-    const auto places = places_.query(context, options_.ring_key_neighbours, allowed);
-    if (!places.empty()) {
-      logger()->debug("loop: keyframe {} (frame {}): nearest place keyframe {} at {:.3f}", keyframe.value,
-                      current->frame_index, places.front().id, places.front().match.distance);
-    }
-    for (const auto& place : places) {
+    for (const auto& place : places_.query(context, options_.ring_key_neighbours, allowed)) {
       if (place.match.distance > options_.max_place_distance) break;  // sorted, best first
       if (std::cmp_greater_equal(step.candidates, options_.max_candidates)) break;
       ++step.candidates;
@@ -106,71 +169,35 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
         best = Verified{std::move(*verified), place.match.distance};
       }
     }
-    // The loop must hold for the keyframes before this one too (ORB-SLAM3 checks covisible keyframes
-    // already in the map rather than waiting for new ones, which a loop ending where the drive ends
-    // never brings): each verifies against the same matched region, and its measured pose relative to
-    // this keyframe agrees with the map's, which odometry knows to centimetres over a few keyframes.
     if (best) {
-      std::vector<KeyframeId> previous;
-      for (auto it = recent_.rbegin(); it != recent_.rend() && std::cmp_less(previous.size() + 1, options_.consistent_keyframes); ++it) {
+      std::vector<KeyframeId> previous;  // the newest live ones, newest first
+      for (auto it = recent_.rbegin();
+           it != recent_.rend() && std::cmp_less(previous.size() + 1, options_.consistent_keyframes); ++it) {
         if (map.keyframe(*it) != nullptr) previous.push_back(*it);
       }
-      step.consistent = std::cmp_equal(previous.size() + 1, options_.consistent_keyframes);
-      const Eigen::Isometry3d& T_cur_world_loop = best->verification.T_cam_world;
-      const Eigen::Isometry3d& T_cur_world_map = current->T_cam_world;
-      for (const KeyframeId id : previous) {
-        if (!step.consistent) break;
-        const Keyframe& k = *map.keyframe(id);
-        LoopVerificationCounts counts;
-        // its pose in the loop's frame if the map is right between the two keyframes
-        const Eigen::Isometry3d T_k_world_guess = k.T_cam_world * T_cur_world_map.inverse() * T_cur_world_loop;
-        const auto again = verify_loop_guided(camera_, k, map, best->verification.constraint.matched, T_k_world_guess,
-                                              options_.verification, &counts);
-        if (!again) {
-          logger()->debug("loop: keyframe {} verified keyframe {} but keyframe {} does not ({} matches, {} RANSAC "
-                          "inliers, {} inliers)",
-                          keyframe.value, best->verification.constraint.matched.value, id.value, counts.matches,
-                          counts.ransac_inliers, counts.inliers);
-          step.consistent = false;
-          break;
+      if (std::cmp_equal(previous.size() + 1, options_.consistent_keyframes)) {
+        if (auto constraints = confirm(camera_, options_, map, *current, *best, previous)) {
+          step.consistent = true;
+          confirmed = std::move(*constraints);
         }
-        const Eigen::Isometry3d loop_rel = T_cur_world_loop * again->T_cam_world.inverse();
-        const Eigen::Isometry3d map_rel = T_cur_world_map * k.T_cam_world.inverse();
-        const Eigen::Isometry3d diff = loop_rel.inverse() * map_rel;
-        const double diff_m = diff.translation().norm(), diff_deg = angle_deg(diff.rotation());
-        if (diff_m > options_.consistency_tolerance_m || diff_deg > options_.consistency_tolerance_deg) {
-          logger()->debug("loop: keyframe {} and {} disagree on the loop by {:.3f} m, {:.2f} deg", keyframe.value,
-                          id.value, diff_m, diff_deg);
-          step.consistent = false;
-          break;
-        }
-        consistent.push_back(again->constraint);
       }
     }
   }
   places_.add(static_cast<std::size_t>(keyframe.value), std::move(context));
-  recent_.push_back(keyframe);
-  if (recent_.size() > static_cast<std::size_t>(options_.consistent_keyframes)) recent_.erase(recent_.begin());
-  if (!best || !step.consistent) {
-    step.time_ms = watch.elapsed_ms();
-    return step;
-  }
+  remember(keyframe);
+  if (!step.consistent) return done();
 
   std::unique_lock lock(map.mutex());
-  const Verified& accepted = *best;
   const Eigen::Isometry3d T_cam_world_before = *map.keyframe_pose(keyframe);
   // How far the map is from the loop's measurement at the current keyframe.
-  const Eigen::Isometry3d& T_cam_world_loop = accepted.verification.T_cam_world;
-  const double disagreement_m = (T_cam_world_loop.inverse().translation() - T_cam_world_before.inverse().translation()).norm();
-  const double disagreement_deg = angle_deg(T_cam_world_loop.rotation() * T_cam_world_before.rotation().transpose());
-  if (disagreement_m <= options_.min_correction_m && disagreement_deg <= options_.min_correction_deg) {
+  const PoseChange disagreement = pose_change(T_cam_world_before, best->verification.T_cam_world);
+  if (disagreement.m <= options_.min_correction_m && disagreement.deg <= options_.min_correction_deg) {
     logger()->debug("loop: keyframe {} confirms keyframe {} ({:.3f} m, {:.2f} deg off): no correction", keyframe.value,
-                    accepted.verification.constraint.matched.value, disagreement_m, disagreement_deg);
-    step.time_ms = watch.elapsed_ms();
-    return step;
+                    best->verification.constraint.matched.value, disagreement.m, disagreement.deg);
+    return done();
   }
-  loops_.push_back(accepted.verification.constraint);
-  loops_.insert(loops_.end(), consistent.begin(), consistent.end());
+  loops_.push_back(best->verification.constraint);
+  loops_.insert(loops_.end(), confirmed.begin(), confirmed.end());
   // Culling may have erased keyframes of earlier loops; their edges go with them.
   std::erase_if(loops_, [&](const LoopConstraint& l) {
     return map.keyframe(l.current) == nullptr || map.keyframe(l.matched) == nullptr;
@@ -178,15 +205,15 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
 
   LoopClosure closure;
   closure.current = keyframe;
-  closure.matched = accepted.verification.constraint.matched;
+  closure.matched = best->verification.constraint.matched;
   closure.frame_index = map.keyframe(keyframe)->frame_index;
   closure.matched_frame_index = map.keyframe(closure.matched)->frame_index;
-  closure.place_distance = accepted.place_distance;
-  closure.inliers = accepted.verification.counts.inliers;
+  closure.place_distance = best->place_distance;
+  closure.inliers = best->verification.counts.inliers;
   closure.correction = correct_loops(map, loops_, options_.correction);
-  const Eigen::Isometry3d T_cam_world_after = *map.keyframe_pose(keyframe);
-  closure.correction_m = (T_cam_world_after.inverse().translation() - T_cam_world_before.inverse().translation()).norm();
-  closure.correction_deg = angle_deg(T_cam_world_after.rotation() * T_cam_world_before.rotation().transpose());
+  const PoseChange moved = pose_change(T_cam_world_before, *map.keyframe_pose(keyframe));
+  closure.correction_m = moved.m;
+  closure.correction_deg = moved.deg;
   closure.time_ms = watch.elapsed_ms();
   logger()->info("loop closed: frame {} with frame {} (place {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
                  "loop error {:.2f} -> {:.3f} m, {:.0f} ms",
@@ -194,8 +221,7 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
                  closure.correction_m, closure.correction_deg, closure.correction.loop_error_before_m,
                  closure.correction.loop_error_after_m, closure.time_ms);
   step.closure = closure;
-  step.time_ms = closure.time_ms;
-  return step;
+  return done();
 }
 
 }  // namespace rgbl

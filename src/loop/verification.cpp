@@ -2,6 +2,7 @@
 
 #include "rgbl/backend/pose_optimizer.hpp"
 #include "rgbl/core/error.hpp"
+#include "rgbl/features/matcher.hpp"
 
 #include <Eigen/Geometry>
 #include <fmt/format.h>
@@ -15,13 +16,13 @@
 namespace rgbl {
 namespace {
 
-struct Match {
+struct PointMatch {
   int keypoint = 0;
   Eigen::Vector3d p_cam;    // current keyframe's camera frame, from its depth
   Eigen::Vector3d p_world;  // the landmark, in the candidate's map
 };
 
-std::vector<Match> match_descriptors(const PinholeCamera& camera, const Keyframe& current, const Map& map,
+std::vector<PointMatch> match_descriptors(const PinholeCamera& camera, const Keyframe& current, const Map& map,
                                      const std::vector<LandmarkId>& landmarks, const LoopVerificationOptions& options) {
   // landmark -> (keypoint, distance): each landmark keeps its best keypoint
   std::map<int, std::pair<int, int>> best_of_landmark;
@@ -47,11 +48,11 @@ std::vector<Match> match_descriptors(const PinholeCamera& camera, const Keyframe
       best_of_landmark[best_id.value] = {static_cast<int>(i), best};
     }
   }
-  std::vector<Match> matches;
+  std::vector<PointMatch> matches;
   matches.reserve(best_of_landmark.size());
   for (const auto& [landmark, kp] : best_of_landmark) {
     const auto k = static_cast<std::size_t>(kp.first);
-    Match m;
+    PointMatch m;
     m.keypoint = kp.first;
     m.p_cam = camera.unproject(Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y), current.depth[k]);
     m.p_world = map.landmark(LandmarkId{landmark})->position;
@@ -60,11 +61,11 @@ std::vector<Match> match_descriptors(const PinholeCamera& camera, const Keyframe
   return matches;
 }
 
-double tolerance(const Match& m, const LoopVerificationOptions& o) {
+double tolerance(const PointMatch& m, const LoopVerificationOptions& o) {
   return std::max(o.min_tolerance, o.relative_tolerance * m.p_cam.z());
 }
 
-int count_agreeing(const std::vector<Match>& matches, const Eigen::Isometry3d& T_cam_world,
+int count_agreeing(const std::vector<PointMatch>& matches, const Eigen::Isometry3d& T_cam_world,
                    const LoopVerificationOptions& options, std::vector<char>* agree = nullptr) {
   int n = 0;
   if (agree != nullptr) agree->assign(matches.size(), 0);
@@ -78,7 +79,7 @@ int count_agreeing(const std::vector<Match>& matches, const Eigen::Isometry3d& T
 }
 
 // Rigid T_cam_world from matched pairs (Umeyama without scale).
-Eigen::Isometry3d align(const std::vector<Match>& matches, const std::vector<std::size_t>& use) {
+Eigen::Isometry3d align(const std::vector<PointMatch>& matches, const std::vector<std::size_t>& use) {
   Eigen::Matrix3Xd world(3, static_cast<Eigen::Index>(use.size())), cam(3, static_cast<Eigen::Index>(use.size()));
   for (std::size_t k = 0; k < use.size(); ++k) {
     world.col(static_cast<Eigen::Index>(k)) = matches[use[k]].p_world;
@@ -92,11 +93,11 @@ Eigen::Isometry3d align(const std::vector<Match>& matches, const std::vector<std
 // Refine on reprojection (and depth where the keypoint has it) of every match; the optimiser
 // re-classifies outliers.
 PoseOptimizerResult refine(const PinholeCamera& camera, const Keyframe& current, const Map& map,
-                           const std::vector<Match>& matches, const Eigen::Isometry3d& T_cam_world,
+                           const std::vector<PointMatch>& matches, const Eigen::Isometry3d& T_cam_world,
                            const LoopVerificationOptions& options) {
   std::vector<PoseObservation> observations;
   observations.reserve(matches.size());
-  for (const Match& m : matches) {
+  for (const PointMatch& m : matches) {
     const auto k = static_cast<std::size_t>(m.keypoint);
     PoseObservation o;
     o.p_world = m.p_world;
@@ -110,17 +111,32 @@ PoseOptimizerResult refine(const PinholeCamera& camera, const Keyframe& current,
   return optimize_pose(camera, T_cam_world, observations);
 }
 
-LoopVerification result(const Keyframe& current, const Keyframe& matched, KeyframeId candidate,
-                        const PoseOptimizerResult& refined, const LoopVerificationCounts& counts) {
+// Refines the pose from T_cam_world and accepts it with enough inliers, absolutely and as a share of
+// the matches; fills reached.inliers either way.
+std::optional<LoopVerification> refine_and_accept(const PinholeCamera& camera, const Keyframe& current, const Map& map,
+                                                  const Keyframe& matched, const std::vector<PointMatch>& matches,
+                                                  const Eigen::Isometry3d& T_cam_world,
+                                                  const LoopVerificationOptions& options, LoopVerificationCounts& reached) {
+  const PoseOptimizerResult refined = refine(camera, current, map, matches, T_cam_world, options);
+  reached.inliers = refined.inliers;
+  if (reached.inliers < options.min_inliers || reached.inliers < options.min_inlier_ratio * reached.matches) {
+    return std::nullopt;
+  }
   LoopVerification v;
-  v.counts = counts;
+  v.counts = reached;
   v.T_cam_world = refined.T_cam_world;
   v.constraint.current = current.id;
-  v.constraint.matched = candidate;
+  v.constraint.matched = matched.id;
   v.constraint.T_current_matched = refined.T_cam_world * matched.T_cam_world.inverse();
   return v;
 }
 
+// Where a loop is looked for: the landmarks of the candidate and of its best covisible keyframes.
+std::vector<LandmarkId> region_landmarks(const Map& map, KeyframeId candidate, std::size_t neighbours) {
+  std::vector<KeyframeId> around{candidate};
+  for (const KeyframeId id : map.best_covisible(candidate, neighbours)) around.push_back(id);
+  return map.landmarks_seen_by(around);
+}
 
 // Options valid and one descriptor and one depth per keypoint, else ConfigError.
 void check(const LoopVerificationOptions& options, const Keyframe& current) {
@@ -156,9 +172,8 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
   reached = {};
   const Keyframe* matched = map.keyframe(candidate);
   if (matched == nullptr) return std::nullopt;
-  std::vector<KeyframeId> around{candidate};
-  for (const KeyframeId id : map.best_covisible(candidate, options.neighbours)) around.push_back(id);
-  const std::vector<Match> matches = match_descriptors(camera, current, map, map.landmarks_seen_by(around), options);
+  const std::vector<PointMatch> matches =
+      match_descriptors(camera, current, map, region_landmarks(map, candidate, options.neighbours), options);
   reached.matches = static_cast<int>(matches.size());
   if (reached.matches < options.min_ransac_inliers) return std::nullopt;
 
@@ -193,10 +208,7 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
   reached.ransac_inliers = count_agreeing(matches, best_T, options);
   if (reached.ransac_inliers < options.min_ransac_inliers) return std::nullopt;
 
-  const PoseOptimizerResult refined = refine(camera, current, map, matches, best_T, options);
-  reached.inliers = refined.inliers;
-  if (reached.inliers < options.min_inliers || reached.inliers < options.min_inlier_ratio * reached.matches) return std::nullopt;
-  return result(current, *matched, candidate, refined, reached);
+  return refine_and_accept(camera, current, map, *matched, matches, best_T, options, reached);
 }
 
 std::optional<LoopVerification> verify_loop_guided(const PinholeCamera& camera, const Keyframe& current, const Map& map,
@@ -209,51 +221,53 @@ std::optional<LoopVerification> verify_loop_guided(const PinholeCamera& camera, 
   reached = {};
   const Keyframe* matched = map.keyframe(candidate);
   if (matched == nullptr) return std::nullopt;
-  std::vector<KeyframeId> around{candidate};
-  for (const KeyframeId id : map.best_covisible(candidate, options.neighbours)) around.push_back(id);
-  // Each region landmark seen from the guess is matched to the closest-descriptor keypoint within the
-  // search radius (scaled by the keypoint's pyramid level); each keypoint keeps its best landmark.
-  std::map<int, std::pair<int, int>> best_of_keypoint;  // keypoint -> (landmark, distance)
-  for (const LandmarkId id : map.landmarks_seen_by(around)) {
+  // Each region landmark seen from the guess is searched near its projection (no ratio test, any
+  // pyramid level; each keypoint keeps its closest landmark).
+  const std::vector<LandmarkId> landmarks = region_landmarks(map, candidate, options.neighbours);
+  const Eigen::Vector3d center = T_cam_world_guess.inverse().translation();
+  std::vector<GuidedQuery> queries;
+  std::vector<LandmarkId> landmark_of_query;
+  queries.reserve(landmarks.size());
+  landmark_of_query.reserve(landmarks.size());
+  for (const LandmarkId id : landmarks) {
     const Landmark& landmark = *map.landmark(id);
     const Eigen::Vector3d p_cam = T_cam_world_guess * landmark.position;
     if (p_cam.z() <= 0.0) continue;
     const auto px = camera.project(p_cam);
     if (!px || !camera.in_image(*px)) continue;
-    int best = options.max_hamming + 1, best_keypoint = -1;
-    for (std::size_t k = 0; k < current.keypoints.size(); ++k) {
-      const double radius = options.guided_radius_px * std::pow(map.options().scale_factor, current.keypoints[k].level);
-      const double dx = current.keypoints[k].x - px->x(), dy = current.keypoints[k].y - px->y();
-      if (dx * dx + dy * dy > radius * radius) continue;
-      const int d = hamming_distance(current.descriptors[k], landmark.descriptor);
-      if (d < best) {
-        best = d;
-        best_keypoint = static_cast<int>(k);
-      }
-    }
-    if (best_keypoint < 0) continue;
-    const auto it = best_of_keypoint.find(best_keypoint);
-    if (it == best_of_keypoint.end() || best < it->second.second) best_of_keypoint[best_keypoint] = {id.value, best};
+    GuidedQuery q;
+    q.x = static_cast<float>(px->x());
+    q.y = static_cast<float>(px->y());
+    q.level = landmark.predict_level((landmark.position - center).norm(), map.options().levels,
+                                     map.options().scale_factor);
+    q.descriptor = &landmark.descriptor;
+    queries.push_back(q);
+    landmark_of_query.push_back(id);
   }
-  std::vector<Match> matches;
-  matches.reserve(best_of_keypoint.size());
-  for (const auto& [keypoint, lm] : best_of_keypoint) {
-    const auto k = static_cast<std::size_t>(keypoint);
-    Match m;
-    m.keypoint = keypoint;
+  GuidedMatchOptions guided;
+  guided.radius = static_cast<float>(options.guided_radius_px);
+  guided.scale_factor = static_cast<float>(map.options().scale_factor);
+  guided.level_window = map.options().levels;
+  guided.max_distance = options.max_hamming;
+  guided.ratio = 1.0F;
+  guided.check_orientation = false;
+  const FeatureGrid grid(current.keypoints, camera.width, camera.height);
+  const std::vector<int> keypoint_of_query = match_guided(queries, grid, current.keypoints, current.descriptors, guided);
+  std::vector<PointMatch> matches;
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    if (keypoint_of_query[q] < 0) continue;
+    const auto k = static_cast<std::size_t>(keypoint_of_query[q]);
+    PointMatch m;
+    m.keypoint = keypoint_of_query[q];
     m.p_cam = current.depth[k] > 0.0F
                   ? camera.unproject(Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y), current.depth[k])
                   : Eigen::Vector3d::Zero();
-    m.p_world = map.landmark(LandmarkId{lm.first})->position;
+    m.p_world = map.landmark(landmark_of_query[q])->position;
     matches.push_back(m);
   }
   reached.matches = static_cast<int>(matches.size());
   if (reached.matches < options.min_inliers) return std::nullopt;
-  const PoseOptimizerResult refined = refine(camera, current, map, matches, T_cam_world_guess, options);
-  reached.inliers = refined.inliers;
-  if (reached.inliers < options.min_inliers || reached.inliers < options.min_inlier_ratio * reached.matches) return std::nullopt;
-  return result(current, *matched, candidate, refined, reached);
+  return refine_and_accept(camera, current, map, *matched, matches, T_cam_world_guess, options, reached);
 }
-
 
 }  // namespace rgbl

@@ -58,9 +58,6 @@ struct System::Impl {
   Impl(SystemOptions o, CameraCalibration c, std::unique_ptr<DepthSource> d, FeatureExtractor e)
       : options(o), calibration(c), depth(std::move(d)), extractor(std::move(e)), map(o.map),
         tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping), closer(c.camera, o.loop_closing) {
-    if (options.threaded_mapping && options.loop_closing.enabled) {
-      logger()->warn("loop closing runs inline only for now: off with threaded mapping");
-    }
     if (options.threaded_mapping) thread = std::thread([this] { run_mapping(); });
   }
 
@@ -116,6 +113,10 @@ System::System(SystemOptions options, CameraCalibration calibration, std::unique
   calibration.camera.validate();
   if (!depth) throw ConfigError("depth", "a depth source");
   if (!extractor) throw ConfigError("extractor", "a feature extractor");
+  if (options.threaded_mapping && options.loop_closing.enabled) {
+    logger()->warn("loop closing runs inline only for now: off with threaded mapping");
+    options.loop_closing.enabled = false;
+  }
   impl_ = std::make_unique<Impl>(options, calibration, std::move(depth), std::move(extractor));
 }
 
@@ -198,7 +199,7 @@ TrackResult System::track(const SensorFrame& sensor) {
 
   // The map's first keyframe is a place too (a loop often ends where the drive started).
   const KeyframeId loop_keyframe = outcome.initialised_now ? s.tracker.reference_keyframe() : new_keyframe;
-  if (loop_keyframe.valid() && !s.options.threaded_mapping && s.options.loop_closing.enabled) {
+  if (loop_keyframe.valid() && s.options.loop_closing.enabled) {
     std::optional<Eigen::Isometry3d> T_ref_world_before;
     {
       std::shared_lock lock(s.map.mutex());
@@ -206,11 +207,8 @@ TrackResult System::track(const SensorFrame& sensor) {
     }
     LoopCloserStep step = s.closer.process(s.map, loop_keyframe, sensor.scan);
     if (step.closure && T_ref_world_before) {
-      s.tracker.follow_map_correction(*T_ref_world_before);
-      std::shared_lock lock(s.map.mutex());
-      // this frame is the reference keyframe: it moves with it
-      frame.T_cam_world = frame.T_cam_world * T_ref_world_before->inverse() *
-                          *s.map.keyframe_pose(s.tracker.reference_keyframe());
+      // this frame is the reference keyframe: it moves with it, as the tracker's last frames do
+      if (const auto moved = s.tracker.follow_map_correction(*T_ref_world_before)) frame.T_cam_world = frame.T_cam_world * *moved;
     }
     result.loop_closure = std::move(step.closure);
   }
@@ -268,5 +266,6 @@ std::vector<TrajectoryPose> System::trajectory() const {
 
 const Map& System::map() const { return impl_->map; }
 const CameraCalibration& System::calibration() const { return impl_->calibration; }
+bool System::loop_closing() const { return impl_->options.loop_closing.enabled; }
 
 }  // namespace rgbl

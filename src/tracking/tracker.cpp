@@ -670,17 +670,18 @@ KeyframeId Tracker::make_keyframe(const Frame& frame) {
   return id;
 }
 
-void Tracker::follow_map_correction(const Eigen::Isometry3d& T_ref_world_before) {
+std::optional<Eigen::Isometry3d> Tracker::follow_map_correction(const Eigen::Isometry3d& T_ref_world_before) {
   std::optional<Eigen::Isometry3d> T_ref_world_after;
   {
     std::shared_lock lock(map_.mutex());
     T_ref_world_after = map_.keyframe_pose(reference_);
   }
-  if (!T_ref_world_after) return;
+  if (!T_ref_world_after) return std::nullopt;
   // A frame rigidly attached to the reference: T_cam_world' = T_cam_ref * T_ref_world'.
   const Eigen::Isometry3d T_before_after = T_ref_world_before.inverse() * *T_ref_world_after;
   if (last_frame_) last_frame_->T_cam_world = last_frame_->T_cam_world * T_before_after;
   if (last_tracked_frame_) last_tracked_frame_->T_cam_world = last_tracked_frame_->T_cam_world * T_before_after;
+  return T_before_after;
 }
 
 }  // namespace rgbl

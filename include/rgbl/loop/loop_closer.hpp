@@ -25,8 +25,8 @@ struct LoopClosingOptions {
   bool enabled = true;
   ScanContextOptions scan_context;
   // Scan Context distance (0 same, 1 unrelated) below which a place is a candidate. On real sequence 04
-  // consecutive scans (1.35 m) score at most 0.20 and scans >= 34 m apart at least 0.50; the same scan
-  // turned by half a sector scores 0.175. Verification, not this bound, decides.
+  // consecutive scans (1.35 m) score at most 0.20 and scans >= 25 frames (~34 m) apart at least 0.49;
+  // the same scan turned by half a sector scores 0.175. Verification, not this bound, decides.
   double max_place_distance = 0.35;
   std::size_t ring_key_neighbours = 10;  // places compared in full per query
   std::size_t max_candidates = 3;        // best places verified per keyframe
@@ -89,7 +89,9 @@ class LoopCloser {
   LoopClosingOptions options_;
   ScanContextDatabase places_;
   std::vector<LoopConstraint> loops_;
-  std::vector<KeyframeId> recent_;  // the latest keyframes processed, oldest first
+  // The latest consistent_keyframes keyframes processed, oldest first (one spare for a culled one).
+  std::vector<KeyframeId> recent_;
+  void remember(KeyframeId keyframe);
 };
 
 }  // namespace rgbl

@@ -29,7 +29,7 @@ struct LoopVerificationOptions {
   int min_inliers = 40;         // after pose refinement (ORB-SLAM asks 40 for a loop, with a Sim3)
   double min_inlier_ratio = 0.3;  // of the matches: a few agreeing among many random ones is chance
   // verify_loop_guided: landmarks are searched this far from where the guess projects them, times the
-  // keypoint's pyramid scale (ORB-SLAM's projection searches use 7.5-15 px at level 0).
+  // scale of the pyramid level their distance predicts (ORB-SLAM's projection searches use 7.5-15 px).
   double guided_radius_px = 10.0;
 
   void validate() const;

@@ -98,6 +98,8 @@ class System {
   // Lock map().mutex() (shared) to read while threaded mapping runs.
   const Map& map() const;
   const CameraCalibration& calibration() const;
+  // Loops are closed: enabled in the options and mapping inline.
+  bool loop_closing() const;
 
  struct Impl;  // public name only so that helpers in the .cpp can take it
 

@@ -40,7 +40,8 @@ class Tracker {
 
   // The map was corrected (a loop closed): the reference keyframe, which was at T_ref_world_before,
   // moved, and the last frames move with it so that the next prediction lands on the corrected map.
-  void follow_map_correction(const Eigen::Isometry3d& T_ref_world_before);
+  // Returns that move as D (a frame's T_cam_world becomes T_cam_world * D); nullopt without a reference.
+  std::optional<Eigen::Isometry3d> follow_map_correction(const Eigen::Isometry3d& T_ref_world_before);
 
   TrackState state() const { return state_; }
   KeyframeId reference_keyframe() const { return reference_; }
