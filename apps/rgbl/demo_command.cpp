@@ -1,4 +1,5 @@
-// rgbl demo [--scenario NAME|list] [--frames N] [--path straight|curve|loop] [--seed S] [--depth SPEC] [--out DIR]
+// rgbl demo [--scenario NAME|list] [--frames N] [--path straight|curve|loop] [--laps N] [--seed S] [--depth SPEC]
+//           [--out DIR] [--no-loop-closing]
 //           [--keep DIR]
 // The main job without a dataset: generates a synthetic street (rgbl::sim) in the KITTI odometry layout
 // and tracks it through exactly the code of `rgbl run` (make_pipeline + run_pipeline), so the accuracy
@@ -34,7 +35,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct DemoArgs {
-  int frames = 0;  // 0: 60 (a bend of the curve), 80 for a loop (the shortest that closes), a scenario's own
+  int frames = 0;  // 0: 60 (a bend of the curve), 80 per lap of a loop (the shortest that closes), a scenario's own
   std::string path = "curve";
   std::string scenario;  // empty: the street of --path
   std::uint64_t seed = 1;
@@ -42,6 +43,8 @@ struct DemoArgs {
   std::string out = "rgbl_demo_output";
   std::string keep;  // dataset folder to keep; empty = a temporary folder, removed afterwards
   bool threaded = false;
+  int laps = 1;  // of --path loop
+  bool no_loop_closing = false;
 };
 
 // A fresh folder under the system's temp directory, removed (with everything in it) on destruction.
@@ -81,21 +84,26 @@ int run_demo(const DemoArgs& args, bool quiet) {
   if (!args.scenario.empty()) {
     sim = scenario_options(args.scenario, args.seed, args.frames);  // throws naming "scenario"
   } else {
-    sim.frames = args.frames > 0 ? args.frames : (args.path == "loop" ? 80 : 60);
+    sim.frames = args.frames > 0 ? args.frames : (args.path == "loop" ? 80 * args.laps : 60);
     sim.seed = args.seed;
     sim.path.kind = *parse_path_kind(args.path);  // CLI11 checked the name
   }
   sim.depth_camera = 0;  // the exact depth of the camera `run` tracks by default
+  if (args.laps != 1 && sim.path.kind != PathKind::loop) {
+    throw ConfigError("--laps", "--path loop (the other paths and the scenarios do not come back)");
+  }
   if (sim.path.kind == PathKind::loop) {
-    // the loop's perimeter is the distance driven: shrink the corners (down to the generator's 12 m)
-    // so that a shorter demo still closes its loop
-    const double perimeter = (sim.frames - 1) * sim.step();
+    // the loop's perimeter is the distance driven over the laps: shrink the corners (down to the
+    // generator's 12 m) so that a shorter demo still closes its loop
+    sim.path.loop_laps = args.laps;
+    const double perimeter = (sim.frames - 1) * sim.step() / args.laps;
     const double radius = std::max(12.0, std::min(sim.path.loop_corner_radius, perimeter / (2.0 * std::numbers::pi)));
     sim.path.loop_corner_radius = radius;
     if (perimeter < 2.0 * std::numbers::pi * radius) {
-      throw ConfigError("--frames", fmt::format("at least {} frames for a loop (corners of {:g} m radius)",
-                                                static_cast<int>(std::ceil(2.0 * std::numbers::pi * radius / sim.step())) + 1,
-                                                radius));
+      throw ConfigError("--frames", fmt::format("at least {} frames for {} lap(s) of a loop (corners of {:g} m radius)",
+                                                static_cast<int>(std::ceil(args.laps * 2.0 * std::numbers::pi * radius /
+                                                                           sim.step())) + 1,
+                                                args.laps, radius));
     }
   }
 
@@ -148,6 +156,7 @@ int run_demo(const DemoArgs& args, bool quiet) {
   // `precomputed` alone: the exact depth images the generator wrote next to the images
   if (input.depth == "precomputed") input.depth = "precomputed:" + (layout.sequence_dir / "depth").string();
   Pipeline pipeline = make_pipeline(input);
+  if (args.no_loop_closing) pipeline.system.loop_closing.enabled = false;
   for (const auto& note : pipeline.notes) fmt::print(stderr, "note: {}\n", note);
   const RunOutcome outcome = run_pipeline(pipeline, args.out, args.threaded, quiet);
 
@@ -167,7 +176,8 @@ Command add_demo_command(CLI::App& parent) {
   auto* app = parent.add_subcommand(
       "demo", "Generate a synthetic street with exact ground truth and track it like `rgbl run` (no dataset needed)");
   auto args = std::make_shared<DemoArgs>();
-  app->add_option("--frames", args->frames, "Frames to generate and track (default: 60; 80 for a loop, which needs >= 77; a scenario's own)")
+  app->add_option("--frames", args->frames, "Frames to generate and track (default: 60; 80 per lap of a loop, which needs >= 77 per lap; a "
+                                   "scenario's own)")
       ->check(CLI::Range(2, 100000));
   auto* path = app->add_option("--path", args->path, "Camera path")
                    ->check(CLI::IsMember({"straight", "curve", "loop"}))
@@ -184,7 +194,11 @@ Command add_demo_command(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--keep", args->keep, "Write the synthetic dataset to this folder and keep it (default: a "
                                         "temporary folder, removed afterwards)");
+  app->add_option("--laps", args->laps, "Laps of --path loop in the frames driven (2: past the start and round again)")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
   app->add_flag("--threaded", args->threaded, "Local mapping in its own thread");
+  app->add_flag("--no-loop-closing", args->no_loop_closing, "Track without loop closing (to compare)");
   return {app, [args, app] {
             const bool quiet = app->get_parent()->get_option("--quiet")->as<bool>();
             return run_demo(*args, quiet);

@@ -52,6 +52,7 @@ void PathOptions::validate() const {
   require(bend_angle_deg > 0.0 && bend_angle_deg <= 180.0, "path.bend_angle_deg", "an angle in (0, 180] degrees");
   require(bend_straight >= 0.0, "path.bend_straight", "a length >= 0 m");
   require(loop_corner_radius >= 12.0, "path.loop_corner_radius", "a radius of at least 12 m");
+  require(loop_laps >= 1 && loop_laps <= 100, "path.loop_laps", "1..100 laps");
   require(std::isfinite(turn_start) && turn_start >= 0.0, "path.turn_start", "a length >= 0 m");
   require(turn_radius >= 8.0 && turn_radius <= 1000.0, "path.turn_radius", "a radius in [8, 1000] m");
   require(turn_angle_deg != 0.0 && std::abs(turn_angle_deg) <= 180.0, "path.turn_angle_deg",
@@ -121,6 +122,7 @@ DrivePath::DrivePath(const PathOptions& options, double length) {
       break;
     }
     case PathKind::loop: {
+      length /= options.loop_laps;  // the perimeter
       const double radius = options.loop_corner_radius;
       const double corners = 2.0 * std::numbers::pi * radius;
       require(length >= corners, "path.loop_corner_radius",

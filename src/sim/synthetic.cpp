@@ -393,8 +393,9 @@ void SyntheticOptions::validate() const {
   require(contrast > 0.1 && contrast <= 4.0, "contrast", "a factor in (0.1, 4]");
   require(contrast_pivot >= 0.0 && contrast_pivot <= 255.0, "contrast_pivot", "a grey level in [0, 255]");
   if (path.kind == PathKind::loop) {
-    require(driven_length() >= 2.0 * std::numbers::pi * path.loop_corner_radius, "frames",
-            "enough frames for the loop: (frames - 1) * speed * frame_period >= 2 pi path.loop_corner_radius");
+    require(driven_length() / path.loop_laps >= 2.0 * std::numbers::pi * path.loop_corner_radius, "frames",
+            "enough frames for the loop: (frames - 1) * speed * frame_period >= path.loop_laps * 2 pi "
+            "path.loop_corner_radius");
   }
   if (untextured) {
     require(untextured->first >= 0 && untextured->first <= untextured->last && untextured->last < frames, "untextured",

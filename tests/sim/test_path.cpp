@@ -87,6 +87,26 @@ TEST_CASE("loop returns exactly to the start") {
   CHECK((path.pose(L - 1e-7).translation() - first.translation()).norm() < 1e-6);
 }
 
+TEST_CASE("a loop of two laps passes its start at half the frames and drives the same track again") {
+  rgbl::SyntheticOptions options;
+  options.frames = 241;  // 240 m: two laps of 120 m
+  options.path.kind = rgbl::PathKind::loop;
+  options.path.loop_laps = 2;
+  const rgbl::SyntheticGenerator generator(options);
+  CHECK_THAT(generator.path().length(), WithinAbs(120.0, 1e-9));
+  for (int i = 0; i <= 120; ++i) {
+    const Eigen::Isometry3d first = generator.pose(i), second = generator.pose(i + 120);
+    REQUIRE((second.translation() - first.translation()).norm() < 1e-9);
+    REQUIRE(rgbl::rotation_angle(second.linear() * first.linear().transpose()) < 1e-9);
+  }
+  CHECK(generator.pose(60).translation().norm() > 30.0);  // it went round in between
+  // the corners must fit into one lap, not into the distance driven
+  options.frames = 120;
+  CHECK_THROWS_WITH(options.validate(), Contains("frames"));
+  options.path.loop_laps = 0;
+  CHECK_THROWS_WITH(options.validate(), Contains("path.loop_laps"));
+}
+
 TEST_CASE("a loop needs enough frames for its corners") {
   rgbl::SyntheticOptions options;
   options.path.kind = rgbl::PathKind::loop;

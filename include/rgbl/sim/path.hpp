@@ -32,6 +32,7 @@ struct PathOptions {
   double bend_angle_deg = 60.0;     // turn of each bend of "curve"
   double bend_straight = 30.0;      // m of straight before each bend of "curve"
   double loop_corner_radius = 15.0; // m, radius of the four corners of "loop"
+  int loop_laps = 1;                // laps of "loop" in the driven length (2: the start is passed once)
   double turn_start = 20.0;         // m of straight before the bend of "turn"
   double turn_radius = 12.0;        // m, radius of the bend of "turn" (of the camera's track)
   double turn_angle_deg = 90.0;     // > 0 turns left, < 0 right
@@ -82,7 +83,8 @@ class DrivePath {
  public:
   // The path of the given kind that covers `length` metres from the start. An open path (straight,
   // curve) continues beyond `length` in the same pattern, and straight before 0 and after its last
-  // segment, so that a scene can be laid out around it. A loop's perimeter is exactly `length`.
+  // segment, so that a scene can be laid out around it. A loop's perimeter is exactly `length` divided
+  // by its laps.
   DrivePath(const PathOptions& options, double length);
   // A custom chain of segments starting at the origin with heading 0; `closed` makes s wrap around.
   DrivePath(std::vector<PathSegment> segments, bool closed);
