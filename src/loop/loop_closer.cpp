@@ -98,8 +98,9 @@ std::optional<std::vector<LoopConstraint>> confirm(const PinholeCamera& camera, 
     const auto again =
         verify_loop_guided(camera, k, map, matched, T_k_cur_map * T_cur_world_loop, options.verification, &counts);
     if (!again) {
-      logger()->debug("loop: keyframe {} verified keyframe {} but keyframe {} does not ({} matches, {} inliers)",
-                      current.id.value, matched.value, id.value, counts.matches, counts.inliers);
+      logger()->debug("loop: keyframe {} verified keyframe {} but keyframe {} does not ({} matches, {} guided, {} "
+                      "inliers)",
+                      current.id.value, matched.value, id.value, counts.matches, counts.guided_matches, counts.inliers);
       return std::nullopt;
     }
     // T_k_cur measured through the loop against the map's: equal when both are right
@@ -160,9 +161,9 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
       const KeyframeId candidate{static_cast<int>(place.id)};
       LoopVerificationCounts counts;
       auto verified = verify_loop(camera_, *current, map, candidate, options_.verification, &counts);
-      logger()->debug("loop: keyframe {} vs {} (place {:.3f}): {} matches, {} RANSAC inliers, {} inliers{}",
+      logger()->debug("loop: keyframe {} vs {} (place {:.3f}): {} matches, {} RANSAC inliers, {} guided, {} inliers{}",
                       keyframe.value, candidate.value, place.match.distance, counts.matches, counts.ransac_inliers,
-                      counts.inliers, verified ? ": verified" : "");
+                      counts.guided_matches, counts.inliers, verified ? ": verified" : "");
       if (!verified) continue;
       ++step.verified;
       if (!best || verified->counts.inliers > best->verification.counts.inliers) {

@@ -119,7 +119,8 @@ std::optional<LoopVerification> refine_and_accept(const PinholeCamera& camera, c
                                                   const LoopVerificationOptions& options, LoopVerificationCounts& reached) {
   const PoseOptimizerResult refined = refine(camera, current, map, matches, T_cam_world, options);
   reached.inliers = refined.inliers;
-  if (reached.inliers < options.min_inliers || reached.inliers < options.min_inlier_ratio * reached.matches) {
+  if (reached.inliers < options.min_inliers ||
+      reached.inliers < options.min_inlier_ratio * static_cast<double>(matches.size())) {
     return std::nullopt;
   }
   LoopVerification v;
@@ -136,6 +137,56 @@ std::vector<LandmarkId> region_landmarks(const Map& map, KeyframeId candidate, s
   std::vector<KeyframeId> around{candidate};
   for (const KeyframeId id : map.best_covisible(candidate, neighbours)) around.push_back(id);
   return map.landmarks_seen_by(around);
+}
+
+// Landmarks seen from T_cam_world, each searched near its projection (no ratio test, any pyramid
+// level, radius guided_radius_px times the scale of the level its distance predicts); each keypoint
+// keeps its closest landmark. Keypoints without depth join by reprojection alone.
+std::vector<PointMatch> guided_search(const PinholeCamera& camera, const Keyframe& current, const Map& map,
+                                      const std::vector<LandmarkId>& landmarks, const Eigen::Isometry3d& T_cam_world,
+                                      const LoopVerificationOptions& options) {
+  const Eigen::Vector3d center = T_cam_world.inverse().translation();
+  std::vector<GuidedQuery> queries;
+  std::vector<LandmarkId> landmark_of_query;
+  queries.reserve(landmarks.size());
+  landmark_of_query.reserve(landmarks.size());
+  for (const LandmarkId id : landmarks) {
+    const Landmark& landmark = *map.landmark(id);
+    const Eigen::Vector3d p_cam = T_cam_world * landmark.position;
+    if (p_cam.z() <= 0.0) continue;
+    const auto px = camera.project(p_cam);
+    if (!px || !camera.in_image(*px)) continue;
+    GuidedQuery q;
+    q.x = static_cast<float>(px->x());
+    q.y = static_cast<float>(px->y());
+    q.level = landmark.predict_level((landmark.position - center).norm(), map.options().levels,
+                                     map.options().scale_factor);
+    q.descriptor = &landmark.descriptor;
+    queries.push_back(q);
+    landmark_of_query.push_back(id);
+  }
+  GuidedMatchOptions guided;
+  guided.radius = static_cast<float>(options.guided_radius_px);
+  guided.scale_factor = static_cast<float>(map.options().scale_factor);
+  guided.level_window = map.options().levels;
+  guided.max_distance = options.max_hamming;
+  guided.ratio = 1.0F;
+  guided.check_orientation = false;
+  const FeatureGrid grid(current.keypoints, camera.width, camera.height);
+  const std::vector<int> keypoint_of_query = match_guided(queries, grid, current.keypoints, current.descriptors, guided);
+  std::vector<PointMatch> matches;
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    if (keypoint_of_query[q] < 0) continue;
+    const auto k = static_cast<std::size_t>(keypoint_of_query[q]);
+    PointMatch m;
+    m.keypoint = keypoint_of_query[q];
+    m.p_cam = current.depth[k] > 0.0F
+                  ? camera.unproject(Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y), current.depth[k])
+                  : Eigen::Vector3d::Zero();
+    m.p_world = map.landmark(landmark_of_query[q])->position;
+    matches.push_back(m);
+  }
+  return matches;
 }
 
 // Options valid and one descriptor and one depth per keypoint, else ConfigError.
@@ -172,8 +223,8 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
   reached = {};
   const Keyframe* matched = map.keyframe(candidate);
   if (matched == nullptr) return std::nullopt;
-  const std::vector<PointMatch> matches =
-      match_descriptors(camera, current, map, region_landmarks(map, candidate, options.neighbours), options);
+  const std::vector<LandmarkId> landmarks = region_landmarks(map, candidate, options.neighbours);
+  const std::vector<PointMatch> matches = match_descriptors(camera, current, map, landmarks, options);
   reached.matches = static_cast<int>(matches.size());
   if (reached.matches < options.min_ransac_inliers) return std::nullopt;
 
@@ -205,10 +256,27 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
     if (agree[i] != 0) consensus.push_back(i);
   }
   best_T = align(matches, consensus);
-  reached.ransac_inliers = count_agreeing(matches, best_T, options);
+  std::vector<PointMatch> agreeing;
+  for (std::size_t i = 0; i < n; ++i) {
+    if ((best_T * matches[i].p_world - matches[i].p_cam).norm() < tolerance(matches[i], options)) {
+      agreeing.push_back(matches[i]);
+    }
+  }
+  reached.ransac_inliers = static_cast<int>(agreeing.size());
   if (reached.ransac_inliers < options.min_ransac_inliers) return std::nullopt;
 
-  return refine_and_accept(camera, current, map, *matched, matches, best_T, options, reached);
+  // Refine on the consensus alone first: a gross outlier close to the camera (a landmark a metre in
+  // front of it) has a huge reprojection Jacobian and drags an undamped Gauss-Newton step away from a
+  // good start. Then every region landmark is searched near where the refined pose projects it: many
+  // more matches than the ratio test lets through, and a pose fixed by them rather than by a few dozen.
+  const PoseOptimizerResult first = refine(camera, current, map, agreeing, best_T, options);
+  if (first.inliers < options.min_ransac_inliers) {
+    reached.inliers = first.inliers;
+    return std::nullopt;
+  }
+  const std::vector<PointMatch> guided = guided_search(camera, current, map, landmarks, first.T_cam_world, options);
+  reached.guided_matches = static_cast<int>(guided.size());
+  return refine_and_accept(camera, current, map, *matched, guided, first.T_cam_world, options, reached);
 }
 
 std::optional<LoopVerification> verify_loop_guided(const PinholeCamera& camera, const Keyframe& current, const Map& map,
@@ -221,53 +289,21 @@ std::optional<LoopVerification> verify_loop_guided(const PinholeCamera& camera, 
   reached = {};
   const Keyframe* matched = map.keyframe(candidate);
   if (matched == nullptr) return std::nullopt;
-  // Each region landmark seen from the guess is searched near its projection (no ratio test, any
-  // pyramid level; each keypoint keeps its closest landmark).
   const std::vector<LandmarkId> landmarks = region_landmarks(map, candidate, options.neighbours);
-  const Eigen::Vector3d center = T_cam_world_guess.inverse().translation();
-  std::vector<GuidedQuery> queries;
-  std::vector<LandmarkId> landmark_of_query;
-  queries.reserve(landmarks.size());
-  landmark_of_query.reserve(landmarks.size());
-  for (const LandmarkId id : landmarks) {
-    const Landmark& landmark = *map.landmark(id);
-    const Eigen::Vector3d p_cam = T_cam_world_guess * landmark.position;
-    if (p_cam.z() <= 0.0) continue;
-    const auto px = camera.project(p_cam);
-    if (!px || !camera.in_image(*px)) continue;
-    GuidedQuery q;
-    q.x = static_cast<float>(px->x());
-    q.y = static_cast<float>(px->y());
-    q.level = landmark.predict_level((landmark.position - center).norm(), map.options().levels,
-                                     map.options().scale_factor);
-    q.descriptor = &landmark.descriptor;
-    queries.push_back(q);
-    landmark_of_query.push_back(id);
-  }
-  GuidedMatchOptions guided;
-  guided.radius = static_cast<float>(options.guided_radius_px);
-  guided.scale_factor = static_cast<float>(map.options().scale_factor);
-  guided.level_window = map.options().levels;
-  guided.max_distance = options.max_hamming;
-  guided.ratio = 1.0F;
-  guided.check_orientation = false;
-  const FeatureGrid grid(current.keypoints, camera.width, camera.height);
-  const std::vector<int> keypoint_of_query = match_guided(queries, grid, current.keypoints, current.descriptors, guided);
-  std::vector<PointMatch> matches;
-  for (std::size_t q = 0; q < queries.size(); ++q) {
-    if (keypoint_of_query[q] < 0) continue;
-    const auto k = static_cast<std::size_t>(keypoint_of_query[q]);
-    PointMatch m;
-    m.keypoint = keypoint_of_query[q];
-    m.p_cam = current.depth[k] > 0.0F
-                  ? camera.unproject(Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y), current.depth[k])
-                  : Eigen::Vector3d::Zero();
-    m.p_world = map.landmark(landmark_of_query[q])->position;
-    matches.push_back(m);
-  }
+  std::vector<PointMatch> matches = guided_search(camera, current, map, landmarks, T_cam_world_guess, options);
   reached.matches = static_cast<int>(matches.size());
-  if (reached.matches < options.min_inliers) return std::nullopt;
-  return refine_and_accept(camera, current, map, *matched, matches, T_cam_world_guess, options, reached);
+  // The guess is the loop's prediction, a little off: refine it on what the first search found (as
+  // much as RANSAC must find in verify_loop) and search again from the refined pose, which finds the
+  // landmarks that fell outside the radius the first time. The decision is on the second search.
+  if (reached.matches < options.min_ransac_inliers) return std::nullopt;
+  const PoseOptimizerResult first = refine(camera, current, map, matches, T_cam_world_guess, options);
+  if (first.inliers < options.min_ransac_inliers) {
+    reached.inliers = first.inliers;
+    return std::nullopt;
+  }
+  matches = guided_search(camera, current, map, landmarks, first.T_cam_world, options);
+  reached.guided_matches = static_cast<int>(matches.size());
+  return refine_and_accept(camera, current, map, *matched, matches, first.T_cam_world, options, reached);
 }
 
 }  // namespace rgbl

@@ -19,6 +19,7 @@ TEST_CASE("loop verification measures the relative pose of two keyframes of one 
   REQUIRE(ids.size() >= 6);
   const rgbl::Keyframe& current = *map.keyframe(ids.back());
   int verified = 0;
+  double worst_m = 0.0, worst_deg = 0.0;
   for (std::size_t k = 0; k + 1 < ids.size(); ++k) {
     const rgbl::Keyframe& earlier = *map.keyframe(ids[k]);
     const double apart = (current.center() - earlier.center()).norm();
@@ -30,13 +31,16 @@ TEST_CASE("loop verification measures the relative pose of two keyframes of one 
     const Eigen::Isometry3d tracked = current.T_cam_world * earlier.T_cam_world.inverse();
     const Eigen::Isometry3d error = tracked.inverse() * v->constraint.T_current_matched;
     CAPTURE(v->counts.matches, v->counts.ransac_inliers, v->counts.inliers, error.translation().norm());
-    CHECK(error.translation().norm() < 0.15);
-    CHECK(rgbl::rotation_angle(error.linear()) < 0.5 * M_PI / 180.0);
+    worst_m = std::max(worst_m, error.translation().norm());
+    worst_deg = std::max(worst_deg, rgbl::rotation_angle(error.linear()) * 180.0 / M_PI);
     CHECK(v->counts.inliers >= 40);
     CHECK(v->constraint.matched == ids[k]);
     CHECK(v->constraint.current == current.id);
   }
   CHECK(verified >= 3);  // keyframes up to ~20 m behind share landmarks ahead
+  WARN("worst " << worst_m << " m " << worst_deg << " deg over " << verified);
+  CHECK(worst_m < 0.06);  // measured 0.029 m, 0.03 deg
+  CHECK(worst_deg < 0.1);
 }
 
 TEST_CASE("loop verification rejects every keyframe of another drive") {

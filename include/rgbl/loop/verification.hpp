@@ -2,8 +2,10 @@
 // Geometric verification of a loop candidate with metric depth: the current keyframe's keypoints that
 // have depth (3-D points in its camera) are matched by descriptor to the landmarks of the candidate
 // keyframe and its best covisible neighbours (3-D points in the map), a 3-point RANSAC finds the rigid
-// motion that aligns them (SE(3): depth is metric, no scale), and the pose of the current keyframe in
-// the candidate's map is refined on reprojection and depth. A loop is the relative pose between the
+// motion that aligns them (SE(3): depth is metric, no scale), the pose of the current keyframe in the
+// candidate's map is refined on that consensus, every region landmark is searched near where that pose
+// projects it (guided search), and the pose is refined again on reprojection and depth of all the
+// guided matches. A loop is the relative pose between the
 // two keyframes; it is only a loop when enough matches agree, and a false loop is worse than none,
 // so every threshold errs on the side of rejecting.
 
@@ -40,7 +42,8 @@ struct LoopVerificationOptions {
 struct LoopVerificationCounts {
   int matches = 0;         // descriptor matches
   int ransac_inliers = 0;  // agreeing with the best 3-point motion (after refitting on its consensus)
-  int inliers = 0;         // after pose refinement
+  int guided_matches = 0;  // found by the guided search from the refined pose
+  int inliers = 0;         // of the guided matches after the final refinement
 };
 
 struct LoopVerification {
@@ -60,8 +63,8 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
 // The same decision from a pose guess instead of descriptor matching alone: the landmarks of the
 // candidate and its neighbours are projected with T_cam_world_guess (the current keyframe in the
 // candidate's map) and matched to keypoints near them (max_hamming, no ratio test: the guess
-// disambiguates), then the pose is refined from the guess (keypoints without depth count by
-// reprojection). For a keyframe next to one already verified, whose pose in the candidate's map
+// disambiguates), the pose is refined from the guess, searched again from the refined pose and refined
+// once more (keypoints without depth count by reprojection). For a keyframe next to one already verified, whose pose in the candidate's map
 // follows from it. `counts.ransac_inliers` stays 0 (no RANSAC).
 std::optional<LoopVerification> verify_loop_guided(const PinholeCamera& camera, const Keyframe& current, const Map& map,
                                                    KeyframeId candidate, const Eigen::Isometry3d& T_cam_world_guess,
