@@ -22,16 +22,33 @@ struct PointMatch {
   Eigen::Vector3d p_world;  // the landmark, in the candidate's map
 };
 
-std::vector<PointMatch> match_descriptors(const PinholeCamera& camera, const Keyframe& current, const Map& map,
-                                     const std::vector<LandmarkId>& landmarks, const LoopVerificationOptions& options) {
+// Where a loop is looked for: the landmarks of the candidate and of its best covisible keyframes.
+std::vector<LandmarkId> region_landmarks(const Map& map, KeyframeId candidate, std::size_t neighbours) {
+  std::vector<KeyframeId> around{candidate};
+  for (const KeyframeId id : map.best_covisible(candidate, neighbours)) around.push_back(id);
+  return map.landmarks_seen_by(around);
+}
+
+// What one verification works on: the current keyframe against the candidate's region.
+struct Search {
+  const PinholeCamera& camera;
+  const Keyframe& current;
+  const Map& map;
+  const Keyframe& matched;
+  const LoopVerificationOptions& options;
+  std::vector<LandmarkId> landmarks;  // region_landmarks of `matched`
+};
+
+std::vector<PointMatch> match_descriptors(const Search& s) {
+  const Keyframe& current = s.current;
   // landmark -> (keypoint, distance): each landmark keeps its best keypoint
   std::map<int, std::pair<int, int>> best_of_landmark;
   for (std::size_t i = 0; i < current.keypoints.size(); ++i) {
     if (current.depth[i] <= 0.0F) continue;
     int best = 256, second = 256;
     LandmarkId best_id;
-    for (const LandmarkId id : landmarks) {
-      const int d = hamming_distance(current.descriptors[i], map.landmark(id)->descriptor);
+    for (const LandmarkId id : s.landmarks) {
+      const int d = hamming_distance(current.descriptors[i], s.map.landmark(id)->descriptor);
       if (d < best) {
         second = best;
         best = d;
@@ -40,7 +57,8 @@ std::vector<PointMatch> match_descriptors(const PinholeCamera& camera, const Key
         second = d;
       }
     }
-    if (!best_id.valid() || best > options.max_hamming || static_cast<float>(best) >= options.ratio * static_cast<float>(second)) {
+    if (!best_id.valid() || best > s.options.max_hamming ||
+        static_cast<float>(best) >= s.options.ratio * static_cast<float>(second)) {
       continue;
     }
     const auto it = best_of_landmark.find(best_id.value);
@@ -54,8 +72,8 @@ std::vector<PointMatch> match_descriptors(const PinholeCamera& camera, const Key
     const auto k = static_cast<std::size_t>(kp.first);
     PointMatch m;
     m.keypoint = kp.first;
-    m.p_cam = camera.unproject(Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y), current.depth[k]);
-    m.p_world = map.landmark(LandmarkId{landmark})->position;
+    m.p_cam = s.camera.unproject(Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y), current.depth[k]);
+    m.p_world = s.map.landmark(LandmarkId{landmark})->position;
     matches.push_back(m);
   }
   return matches;
@@ -65,17 +83,23 @@ double tolerance(const PointMatch& m, const LoopVerificationOptions& o) {
   return std::max(o.min_tolerance, o.relative_tolerance * m.p_cam.z());
 }
 
+bool agrees(const PointMatch& m, const Eigen::Isometry3d& T_cam_world, const LoopVerificationOptions& options) {
+  return (T_cam_world * m.p_world - m.p_cam).norm() < tolerance(m, options);
+}
+
 int count_agreeing(const std::vector<PointMatch>& matches, const Eigen::Isometry3d& T_cam_world,
-                   const LoopVerificationOptions& options, std::vector<char>* agree = nullptr) {
-  int n = 0;
-  if (agree != nullptr) agree->assign(matches.size(), 0);
+                   const LoopVerificationOptions& options) {
+  return static_cast<int>(
+      std::count_if(matches.begin(), matches.end(), [&](const PointMatch& m) { return agrees(m, T_cam_world, options); }));
+}
+
+std::vector<std::size_t> agreeing(const std::vector<PointMatch>& matches, const Eigen::Isometry3d& T_cam_world,
+                                  const LoopVerificationOptions& options) {
+  std::vector<std::size_t> out;
   for (std::size_t i = 0; i < matches.size(); ++i) {
-    if ((T_cam_world * matches[i].p_world - matches[i].p_cam).norm() < tolerance(matches[i], options)) {
-      ++n;
-      if (agree != nullptr) (*agree)[i] = 1;
-    }
+    if (agrees(matches[i], T_cam_world, options)) out.push_back(i);
   }
-  return n;
+  return out;
 }
 
 // Rigid T_cam_world from matched pairs (Umeyama without scale).
@@ -92,9 +116,8 @@ Eigen::Isometry3d align(const std::vector<PointMatch>& matches, const std::vecto
 
 // Refine on reprojection (and depth where the keypoint has it) of every match; the optimiser
 // re-classifies outliers.
-PoseOptimizerResult refine(const PinholeCamera& camera, const Keyframe& current, const Map& map,
-                           const std::vector<PointMatch>& matches, const Eigen::Isometry3d& T_cam_world,
-                           const LoopVerificationOptions& options) {
+PoseOptimizerResult refine(const Search& s, const std::vector<PointMatch>& matches, const Eigen::Isometry3d& T_cam_world) {
+  const Keyframe& current = s.current;
   std::vector<PoseObservation> observations;
   observations.reserve(matches.size());
   for (const PointMatch& m : matches) {
@@ -102,77 +125,47 @@ PoseOptimizerResult refine(const PinholeCamera& camera, const Keyframe& current,
     PoseObservation o;
     o.p_world = m.p_world;
     o.pixel = Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y);
-    o.sigma_px = std::pow(map.options().scale_factor, current.keypoints[k].level);
+    o.sigma_px = std::pow(s.map.options().scale_factor, current.keypoints[k].level);
     o.depth = current.depth[k];
     o.depth_sigma = k < current.depth_sigma.size() && current.depth_sigma[k] > 0.0F ? current.depth_sigma[k]
-                                                                                      : tolerance(m, options);
+                                                                                      : tolerance(m, s.options);
     observations.push_back(o);
   }
-  return optimize_pose(camera, T_cam_world, observations);
+  return optimize_pose(s.camera, T_cam_world, observations);
 }
 
-// Refines the pose from T_cam_world and accepts it with enough inliers, absolutely and as a share of
-// the matches; fills reached.inliers either way.
-std::optional<LoopVerification> refine_and_accept(const PinholeCamera& camera, const Keyframe& current, const Map& map,
-                                                  const Keyframe& matched, const std::vector<PointMatch>& matches,
-                                                  const Eigen::Isometry3d& T_cam_world,
-                                                  const LoopVerificationOptions& options, LoopVerificationCounts& reached) {
-  const PoseOptimizerResult refined = refine(camera, current, map, matches, T_cam_world, options);
-  reached.inliers = refined.inliers;
-  if (reached.inliers < options.min_inliers ||
-      reached.inliers < options.min_inlier_ratio * static_cast<double>(matches.size())) {
-    return std::nullopt;
-  }
-  LoopVerification v;
-  v.counts = reached;
-  v.T_cam_world = refined.T_cam_world;
-  v.constraint.current = current.id;
-  v.constraint.matched = matched.id;
-  v.constraint.T_current_matched = refined.T_cam_world * matched.T_cam_world.inverse();
-  return v;
-}
-
-// Where a loop is looked for: the landmarks of the candidate and of its best covisible keyframes.
-std::vector<LandmarkId> region_landmarks(const Map& map, KeyframeId candidate, std::size_t neighbours) {
-  std::vector<KeyframeId> around{candidate};
-  for (const KeyframeId id : map.best_covisible(candidate, neighbours)) around.push_back(id);
-  return map.landmarks_seen_by(around);
-}
-
-// Landmarks seen from T_cam_world, each searched near its projection (no ratio test, any pyramid
-// level, radius guided_radius_px times the scale of the level its distance predicts); each keypoint
-// keeps its closest landmark. Keypoints without depth join by reprojection alone.
-std::vector<PointMatch> guided_search(const PinholeCamera& camera, const Keyframe& current, const Map& map,
-                                      const std::vector<LandmarkId>& landmarks, const Eigen::Isometry3d& T_cam_world,
-                                      const LoopVerificationOptions& options) {
+// Region landmarks seen from T_cam_world, each searched near its projection (no ratio test, any
+// pyramid level, radius guided_radius_px times the scale of the level its distance predicts); each
+// keypoint keeps its closest landmark. Keypoints without depth join by reprojection alone.
+std::vector<PointMatch> guided_search(const Search& s, const FeatureGrid& grid, const Eigen::Isometry3d& T_cam_world) {
+  const MapOptions& map_options = s.map.options();
   const Eigen::Vector3d center = T_cam_world.inverse().translation();
   std::vector<GuidedQuery> queries;
   std::vector<LandmarkId> landmark_of_query;
-  queries.reserve(landmarks.size());
-  landmark_of_query.reserve(landmarks.size());
-  for (const LandmarkId id : landmarks) {
-    const Landmark& landmark = *map.landmark(id);
+  queries.reserve(s.landmarks.size());
+  landmark_of_query.reserve(s.landmarks.size());
+  for (const LandmarkId id : s.landmarks) {
+    const Landmark& landmark = *s.map.landmark(id);
     const Eigen::Vector3d p_cam = T_cam_world * landmark.position;
     if (p_cam.z() <= 0.0) continue;
-    const auto px = camera.project(p_cam);
-    if (!px || !camera.in_image(*px)) continue;
+    const auto px = s.camera.project(p_cam);
+    if (!px || !s.camera.in_image(*px)) continue;
     GuidedQuery q;
     q.x = static_cast<float>(px->x());
     q.y = static_cast<float>(px->y());
-    q.level = landmark.predict_level((landmark.position - center).norm(), map.options().levels,
-                                     map.options().scale_factor);
+    q.level = landmark.predict_level((landmark.position - center).norm(), map_options.levels, map_options.scale_factor);
     q.descriptor = &landmark.descriptor;
     queries.push_back(q);
     landmark_of_query.push_back(id);
   }
   GuidedMatchOptions guided;
-  guided.radius = static_cast<float>(options.guided_radius_px);
-  guided.scale_factor = static_cast<float>(map.options().scale_factor);
-  guided.level_window = map.options().levels;
-  guided.max_distance = options.max_hamming;
+  guided.radius = static_cast<float>(s.options.guided_radius_px);
+  guided.scale_factor = static_cast<float>(map_options.scale_factor);
+  guided.level_window = map_options.levels;
+  guided.max_distance = s.options.max_hamming;
   guided.ratio = 1.0F;
   guided.check_orientation = false;
-  const FeatureGrid grid(current.keypoints, camera.width, camera.height);
+  const Keyframe& current = s.current;
   const std::vector<int> keypoint_of_query = match_guided(queries, grid, current.keypoints, current.descriptors, guided);
   std::vector<PointMatch> matches;
   for (std::size_t q = 0; q < queries.size(); ++q) {
@@ -180,13 +173,41 @@ std::vector<PointMatch> guided_search(const PinholeCamera& camera, const Keyfram
     const auto k = static_cast<std::size_t>(keypoint_of_query[q]);
     PointMatch m;
     m.keypoint = keypoint_of_query[q];
-    m.p_cam = current.depth[k] > 0.0F
-                  ? camera.unproject(Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y), current.depth[k])
-                  : Eigen::Vector3d::Zero();
-    m.p_world = map.landmark(landmark_of_query[q])->position;
+    m.p_cam = current.depth[k] > 0.0F ? s.camera.unproject(Eigen::Vector2d(current.keypoints[k].x, current.keypoints[k].y),
+                                                           current.depth[k])
+                                      : Eigen::Vector3d::Zero();
+    m.p_world = s.map.landmark(landmark_of_query[q])->position;
     matches.push_back(m);
   }
   return matches;
+}
+
+// The common end of both verifications: the pose is refined from T_cam_world on `matches` (needs
+// min_ransac_inliers inliers), every region landmark is searched from the refined pose, and the pose
+// refined on those guided matches is accepted with enough inliers, absolutely and as a share of them.
+std::optional<LoopVerification> refine_search_accept(const Search& s, const FeatureGrid& grid,
+                                                     const std::vector<PointMatch>& matches,
+                                                     const Eigen::Isometry3d& T_cam_world, LoopVerificationCounts& reached) {
+  const PoseOptimizerResult first = refine(s, matches, T_cam_world);
+  if (first.inliers < s.options.min_ransac_inliers) {
+    reached.inliers = first.inliers;
+    return std::nullopt;
+  }
+  const std::vector<PointMatch> guided = guided_search(s, grid, first.T_cam_world);
+  reached.guided_matches = static_cast<int>(guided.size());
+  const PoseOptimizerResult refined = refine(s, guided, first.T_cam_world);
+  reached.inliers = refined.inliers;
+  if (reached.inliers < s.options.min_inliers ||
+      reached.inliers < s.options.min_inlier_ratio * static_cast<double>(guided.size())) {
+    return std::nullopt;
+  }
+  LoopVerification v;
+  v.counts = reached;
+  v.T_cam_world = refined.T_cam_world;
+  v.constraint.current = s.current.id;
+  v.constraint.matched = s.matched.id;
+  v.constraint.T_current_matched = refined.T_cam_world * s.matched.T_cam_world.inverse();
+  return v;
 }
 
 // Options valid and one descriptor and one depth per keypoint, else ConfigError.
@@ -223,8 +244,8 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
   reached = {};
   const Keyframe* matched = map.keyframe(candidate);
   if (matched == nullptr) return std::nullopt;
-  const std::vector<LandmarkId> landmarks = region_landmarks(map, candidate, options.neighbours);
-  const std::vector<PointMatch> matches = match_descriptors(camera, current, map, landmarks, options);
+  const Search search{camera, current, map, *matched, options, region_landmarks(map, candidate, options.neighbours)};
+  const std::vector<PointMatch> matches = match_descriptors(search);
   reached.matches = static_cast<int>(matches.size());
   if (reached.matches < options.min_ransac_inliers) return std::nullopt;
 
@@ -249,34 +270,20 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
   }
   reached.ransac_inliers = best_count;
   if (best_count < options.min_ransac_inliers) return std::nullopt;
-  std::vector<char> agree;
-  count_agreeing(matches, best_T, options, &agree);
-  std::vector<std::size_t> consensus;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (agree[i] != 0) consensus.push_back(i);
-  }
-  best_T = align(matches, consensus);
-  std::vector<PointMatch> agreeing;
-  for (std::size_t i = 0; i < n; ++i) {
-    if ((best_T * matches[i].p_world - matches[i].p_cam).norm() < tolerance(matches[i], options)) {
-      agreeing.push_back(matches[i]);
-    }
-  }
-  reached.ransac_inliers = static_cast<int>(agreeing.size());
+  best_T = align(matches, agreeing(matches, best_T, options));  // refit on the consensus
+  const std::vector<std::size_t> consensus = agreeing(matches, best_T, options);
+  reached.ransac_inliers = static_cast<int>(consensus.size());
   if (reached.ransac_inliers < options.min_ransac_inliers) return std::nullopt;
 
   // Refine on the consensus alone first: a gross outlier close to the camera (a landmark a metre in
   // front of it) has a huge reprojection Jacobian and drags an undamped Gauss-Newton step away from a
-  // good start. Then every region landmark is searched near where the refined pose projects it: many
-  // more matches than the ratio test lets through, and a pose fixed by them rather than by a few dozen.
-  const PoseOptimizerResult first = refine(camera, current, map, agreeing, best_T, options);
-  if (first.inliers < options.min_ransac_inliers) {
-    reached.inliers = first.inliers;
-    return std::nullopt;
-  }
-  const std::vector<PointMatch> guided = guided_search(camera, current, map, landmarks, first.T_cam_world, options);
-  reached.guided_matches = static_cast<int>(guided.size());
-  return refine_and_accept(camera, current, map, *matched, guided, first.T_cam_world, options, reached);
+  // good start. The guided search from the refined pose then brings in many more matches than the
+  // ratio test lets through, and the pose is fixed by them rather than by a few dozen.
+  std::vector<PointMatch> consensus_matches;
+  consensus_matches.reserve(consensus.size());
+  for (const std::size_t i : consensus) consensus_matches.push_back(matches[i]);
+  const FeatureGrid grid(current.keypoints, camera.width, camera.height);
+  return refine_search_accept(search, grid, consensus_matches, best_T, reached);
 }
 
 std::optional<LoopVerification> verify_loop_guided(const PinholeCamera& camera, const Keyframe& current, const Map& map,
@@ -289,21 +296,15 @@ std::optional<LoopVerification> verify_loop_guided(const PinholeCamera& camera, 
   reached = {};
   const Keyframe* matched = map.keyframe(candidate);
   if (matched == nullptr) return std::nullopt;
-  const std::vector<LandmarkId> landmarks = region_landmarks(map, candidate, options.neighbours);
-  std::vector<PointMatch> matches = guided_search(camera, current, map, landmarks, T_cam_world_guess, options);
+  const Search search{camera, current, map, *matched, options, region_landmarks(map, candidate, options.neighbours)};
+  const FeatureGrid grid(current.keypoints, camera.width, camera.height);
+  // The guess is the loop's prediction, a little off: a first search from it needs as many matches as
+  // RANSAC must find in verify_loop; the refined pose is searched from again, which finds the landmarks
+  // that fell outside the radius the first time, and the decision is on that second search.
+  const std::vector<PointMatch> matches = guided_search(search, grid, T_cam_world_guess);
   reached.matches = static_cast<int>(matches.size());
-  // The guess is the loop's prediction, a little off: refine it on what the first search found (as
-  // much as RANSAC must find in verify_loop) and search again from the refined pose, which finds the
-  // landmarks that fell outside the radius the first time. The decision is on the second search.
   if (reached.matches < options.min_ransac_inliers) return std::nullopt;
-  const PoseOptimizerResult first = refine(camera, current, map, matches, T_cam_world_guess, options);
-  if (first.inliers < options.min_ransac_inliers) {
-    reached.inliers = first.inliers;
-    return std::nullopt;
-  }
-  matches = guided_search(camera, current, map, landmarks, first.T_cam_world, options);
-  reached.guided_matches = static_cast<int>(matches.size());
-  return refine_and_accept(camera, current, map, *matched, matches, first.T_cam_world, options, reached);
+  return refine_search_accept(search, grid, matches, T_cam_world_guess, reached);
 }
 
 }  // namespace rgbl

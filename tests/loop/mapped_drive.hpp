@@ -18,11 +18,12 @@ struct Mapped {
   std::vector<TrackResult> results;
 };
 
-// Tracks the first `frames` frames of `sequence` (camera 0, LiDAR depth).
-inline Mapped map_drive(const std::unique_ptr<Sequence>& sequence, std::size_t frames,
-                        const SystemOptions& options = {}) {
+// Tracks `count` frames, load(i) giving each as a FrameInput (by value or by reference; camera 0's
+// image and the LiDAR scan are used), with LiDAR depth and the default ORB extractor.
+template <class Load>
+Mapped track_frames(const CameraCalibration& calibration, std::size_t count, Load load, const SystemOptions& options = {}) {
   Mapped m;
-  m.calibration = sequence->calibration().camera(0);
+  m.calibration = calibration;
   DepthSourceSettings depth;
   depth.calibration = m.calibration;
   auto orb = std::make_shared<OrbExtractor>();
@@ -30,8 +31,8 @@ inline Mapped map_drive(const std::unique_ptr<Sequence>& sequence, std::size_t f
                                       [orb](const cv::Mat& gray, std::vector<Keypoint>& kps, std::vector<Descriptor>& desc) {
                                         orb->extract(gray, kps, desc);
                                       });
-  for (std::size_t i = 0; i < std::min(frames, sequence->size()); ++i) {
-    const FrameInput input = sequence->load(i);
+  for (std::size_t i = 0; i < count; ++i) {
+    const FrameInput& input = load(i);  // a temporary lives until the end of this iteration
     SensorFrame frame;
     frame.index = i;
     frame.timestamp = input.timestamp;
@@ -41,6 +42,13 @@ inline Mapped map_drive(const std::unique_ptr<Sequence>& sequence, std::size_t f
   }
   m.system->finish();
   return m;
+}
+
+// Tracks the first `frames` frames of `sequence` (camera 0, LiDAR depth).
+inline Mapped map_drive(const std::unique_ptr<Sequence>& sequence, std::size_t frames,
+                        const SystemOptions& options = {}) {
+  return track_frames(sequence->calibration().camera(0), std::min(frames, sequence->size()),
+                      [&](std::size_t i) { return sequence->load(i); }, options);
 }
 
 }  // namespace rgbl::test

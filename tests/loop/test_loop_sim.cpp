@@ -1,23 +1,19 @@
 // Loop closing on the simulator's loop driven twice, where the truth says which places are the same:
 // every closure must pair frames of one place, and closing must pay off on the whole trajectory.
 
-#include "rgbl/depth/sources.hpp"
 #include "rgbl/eval/trajectory_metrics.hpp"
-#include "rgbl/features/orb.hpp"
 #include "rgbl/sim/synthetic.hpp"
-#include "rgbl/tracking/system.hpp"
+#include "mapped_drive.hpp"
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
 
-#include <memory>
 #include <vector>
 
 namespace {
 
 struct Lap {
-  std::vector<cv::Mat> images;
-  std::vector<std::vector<rgbl::LidarPoint>> scans;
+  std::vector<rgbl::FrameInput> frames;  // camera 0's image and the scan
   std::vector<Eigen::Isometry3d> truth;
   rgbl::CameraCalibration calibration;
 };
@@ -35,8 +31,12 @@ const Lap& two_laps() {
     Lap l;
     l.calibration = generator.calibration().camera(0);
     for (int i = 0; i < options.frames; ++i) {
-      l.images.push_back(generator.render_image(i, 0));
-      l.scans.push_back(generator.render_scan(i));
+      rgbl::FrameInput f;
+      f.index = static_cast<std::size_t>(i);
+      f.timestamp = generator.timestamp(i);
+      f.images[0] = generator.render_image(i, 0);
+      f.scan = generator.render_scan(i);
+      l.frames.push_back(std::move(f));
       l.truth.push_back(generator.pose(i));
     }
     return l;
@@ -52,27 +52,13 @@ struct Run {
 Run track(const Lap& lap, bool loop_closing) {
   rgbl::SystemOptions options;
   options.loop_closing.enabled = loop_closing;
-  rgbl::DepthSourceSettings depth;
-  depth.calibration = lap.calibration;
-  auto orb = std::make_shared<rgbl::OrbExtractor>();
-  rgbl::System system(options, lap.calibration, rgbl::make_lidar_source(depth),
-                      [orb](const cv::Mat& grey, std::vector<rgbl::Keypoint>& keypoints,
-                            std::vector<rgbl::Descriptor>& descriptors) { orb->extract(grey, keypoints, descriptors); });
-  Run run;
-  for (std::size_t i = 0; i < lap.images.size(); ++i) {
-    rgbl::SensorFrame frame;
-    frame.index = i;
-    frame.timestamp = 0.1 * static_cast<double>(i);
-    frame.image = lap.images[i];
-    frame.scan = lap.scans[i];
-    run.results.push_back(system.track(frame));
-  }
-  system.finish();
+  const rgbl::test::Mapped m = rgbl::test::track_frames(
+      lap.calibration, lap.frames.size(), [&](std::size_t i) -> const rgbl::FrameInput& { return lap.frames[i]; },
+      options);
   std::vector<Eigen::Isometry3d> estimate;
-  for (const auto& p : system.trajectory()) estimate.push_back(p.T_world_cam);
+  for (const auto& p : m.system->trajectory()) estimate.push_back(p.T_world_cam);
   REQUIRE(estimate.size() == lap.truth.size());
-  run.ate = rgbl::absolute_trajectory_error(estimate, lap.truth).translation.rmse;
-  return run;
+  return {m.results, rgbl::absolute_trajectory_error(estimate, lap.truth).translation.rmse};
 }
 
 }  // namespace

@@ -5,9 +5,8 @@
 // motion that aligns them (SE(3): depth is metric, no scale), the pose of the current keyframe in the
 // candidate's map is refined on that consensus, every region landmark is searched near where that pose
 // projects it (guided search), and the pose is refined again on reprojection and depth of all the
-// guided matches. A loop is the relative pose between the
-// two keyframes; it is only a loop when enough matches agree, and a false loop is worse than none,
-// so every threshold errs on the side of rejecting.
+// guided matches. A loop is the relative pose between the two keyframes; it is only a loop when enough
+// matches agree, and a false loop is worse than none, so every threshold errs on the side of rejecting.
 
 #include "rgbl/backend/loop_correction.hpp"
 #include "rgbl/geometry/camera.hpp"
@@ -64,8 +63,9 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
 // candidate and its neighbours are projected with T_cam_world_guess (the current keyframe in the
 // candidate's map) and matched to keypoints near them (max_hamming, no ratio test: the guess
 // disambiguates), the pose is refined from the guess, searched again from the refined pose and refined
-// once more (keypoints without depth count by reprojection). For a keyframe next to one already verified, whose pose in the candidate's map
-// follows from it. `counts.ransac_inliers` stays 0 (no RANSAC).
+// once more (keypoints without depth count by reprojection). For a keyframe next to one already
+// verified, whose pose in the candidate's map follows from it. `counts.ransac_inliers` stays 0 (no
+// RANSAC).
 std::optional<LoopVerification> verify_loop_guided(const PinholeCamera& camera, const Keyframe& current, const Map& map,
                                                    KeyframeId candidate, const Eigen::Isometry3d& T_cam_world_guess,
                                                    const LoopVerificationOptions& options = {},
