@@ -62,6 +62,7 @@ void LocalMappingOptions::validate() const {
   require(max_local_ba_keyframes >= 1, "local_mapping.max_local_ba_keyframes", ">= 1");
   require(min_found_ratio >= 0.0 && min_found_ratio <= 1.0, "local_mapping.min_found_ratio", "in [0, 1]");
   require(redundant_ratio > 0.0 && redundant_ratio <= 1.0, "local_mapping.redundant_ratio", "in (0, 1]");
+  fusion_match.validate();
   ba.validate();
 }
 

@@ -5,6 +5,7 @@
 #include "rgbl/backend/bundle_adjustment.hpp"
 #include "rgbl/backend/depth_noise.hpp"
 #include "rgbl/backend/pose_optimizer.hpp"
+#include "rgbl/map/fusion.hpp"
 #include "rgbl/map/map.hpp"
 
 namespace rgbl {
@@ -128,7 +129,7 @@ struct LocalMappingOptions {
   int min_new_depth_points = 100;       // at least this many new landmarks from depth per keyframe
   int max_new_depth_points = 1000;
   int covisible_for_fusion = 10;
-  double fusion_radius = 3.0;           // px at level 0
+  FusionOptions fusion_match;           // 3 px at level 0, Hamming <= 50
   int max_local_ba_keyframes = 10;      // optimised keyframes (the current one and its best covisible)
   int max_fixed_keyframes = 20;
   double min_found_ratio = 0.25;        // landmark culling

@@ -1,0 +1,80 @@
+#include "rgbl/backend/map_bundle.hpp"
+
+#include <cmath>
+#include <map>
+#include <set>
+
+namespace rgbl {
+
+MapBundle make_map_bundle(const Map& map, std::span<const KeyframeId> window, std::span<const KeyframeId> anchors,
+                          KeyframeId held) {
+  MapBundle bundle;
+  std::map<KeyframeId, int> pose_index;
+  const auto add_pose = [&](KeyframeId k, bool fixed) {
+    const Keyframe* kf = map.keyframe(k);
+    if (kf == nullptr || pose_index.count(k) != 0) return;
+    pose_index[k] = static_cast<int>(bundle.problem.poses.size());
+    bundle.problem.poses.push_back({kf->T_cam_world, fixed});
+    bundle.keyframes.push_back(k);
+  };
+  for (const KeyframeId k : window) add_pose(k, k == held);
+  const std::size_t window_poses = bundle.keyframes.size();
+  for (const KeyframeId k : anchors) add_pose(k, true);
+
+  std::set<LandmarkId> points;
+  for (std::size_t i = 0; i < window_poses; ++i) {
+    for (const LandmarkId l : map.keyframe(bundle.keyframes[i])->landmarks) {
+      if (l.valid()) points.insert(l);
+    }
+  }
+  const double scale = map.options().scale_factor;
+  for (const LandmarkId l : points) {
+    const Landmark* landmark = map.landmark(l);
+    const int point = static_cast<int>(bundle.problem.points.size());
+    bundle.problem.points.push_back(landmark->position);
+    bundle.landmarks.push_back(l);
+    for (const auto& [k, index] : landmark->observations) {
+      const auto it = pose_index.find(k);
+      if (it == pose_index.end()) continue;
+      const Keyframe* kf = map.keyframe(k);
+      const auto ks = static_cast<std::size_t>(index);
+      BundleObservation o;
+      o.pose = it->second;
+      o.point = point;
+      o.pixel = Eigen::Vector2d(kf->keypoints[ks].x, kf->keypoints[ks].y);
+      o.sigma_px = std::pow(scale, kf->keypoints[ks].level);
+      if (kf->depth_sigma[ks] > 0.0F) {
+        o.depth = kf->depth[ks];
+        o.depth_sigma = kf->depth_sigma[ks];
+      }
+      bundle.problem.observations.push_back(o);
+      bundle.observations.emplace_back(l, k);
+    }
+  }
+  return bundle;
+}
+
+int apply_map_bundle(Map& map, const MapBundle& bundle, const BundleAdjustmentResult& result) {
+  int outliers = 0;
+  for (std::size_t i = 0; i < bundle.observations.size() && i < result.outlier.size(); ++i) {
+    if (!result.outlier[i]) continue;
+    map.erase_observation(bundle.observations[i].first, bundle.observations[i].second);
+    ++outliers;
+  }
+  for (std::size_t i = 0; i < bundle.keyframes.size(); ++i) {
+    if (bundle.problem.poses[i].fixed) continue;
+    if (Keyframe* kf = map.keyframe(bundle.keyframes[i])) kf->T_cam_world = bundle.problem.poses[i].T_cam_world;
+  }
+  for (std::size_t i = 0; i < bundle.landmarks.size(); ++i) {
+    if (Landmark* l = map.landmark(bundle.landmarks[i])) {
+      l->position = bundle.problem.points[i];
+      map.update_landmark(bundle.landmarks[i]);
+    }
+  }
+  if (outliers > 0) {
+    for (const KeyframeId k : bundle.keyframes) map.update_covisibility(k);
+  }
+  return outliers;
+}
+
+}  // namespace rgbl
