@@ -295,10 +295,12 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
     loop_closures += fmt::format(
         "{}\n    {{\"frame\": {}, \"matched_frame\": {}, \"place_distance\": {}, \"inliers\": {}, "
         "\"correction_m\": {}, \"correction_deg\": {}, \"loop_error_before_m\": {}, \"loop_error_after_m\": {}, "
-        "\"time_ms\": {}}}",
+        "\"fused_landmarks\": {}, \"global_ba\": {{\"keyframes\": {}, \"landmarks\": {}, \"outliers\": {}, "
+        "\"time_ms\": {}}}, \"time_ms\": {}}}",
         loop_closures.empty() ? "" : ",", c.frame_index, c.matched_frame_index, json_number(c.place_distance), c.inliers,
         json_number(c.correction_m), json_number(c.correction_deg), json_number(c.correction.loop_error_before_m),
-        json_number(c.correction.loop_error_after_m), json_number(c.time_ms));
+        json_number(c.correction.loop_error_after_m), c.fused_landmarks, c.global_ba_keyframes, c.global_ba_landmarks,
+        c.global_ba_outliers, json_number(c.global_ba_ms), json_number(c.time_ms));
   }
   if (!loop_closures.empty()) loop_closures += "\n  ";
   {
@@ -338,8 +340,10 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
   if (!jump_frames.empty()) fmt::print("  steps beyond a vehicle's reach taken at frame(s) {}\n", jump_frames);
   if (!new_map_frames.empty()) fmt::print("  lost beyond relocalisation: new map started at frame(s) {}\n", new_map_frames);
   for (const LoopClosure* c : closures) {
-    fmt::print("  loop closed at frame {} with frame {}: map moved {:.2f} m / {:.2f} deg there, {:.0f} ms\n",
-               c->frame_index, c->matched_frame_index, c->correction_m, c->correction_deg, c->time_ms);
+    fmt::print("  loop closed at frame {} with frame {}: map moved {:.2f} m / {:.2f} deg there, {} landmarks fused, "
+               "{:.0f} ms (global BA of {} keyframes {:.0f} ms)\n",
+               c->frame_index, c->matched_frame_index, c->correction_m, c->correction_deg, c->fused_landmarks,
+               c->time_ms, c->global_ba_keyframes, c->global_ba_ms);
   }
   fmt::print("  per frame (median / p95 ms): depth {:.2f} / {:.2f}, extraction {:.2f} / {:.2f}, tracking {:.2f} / "
              "{:.2f}, mapping {:.2f} / {:.2f}\n",

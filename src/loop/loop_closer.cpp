@@ -3,6 +3,7 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/log.hpp"
 #include "rgbl/core/timer.hpp"
+#include "rgbl/backend/map_bundle.hpp"
 #include "rgbl/geometry/se3.hpp"
 
 #include <Eigen/Geometry>
@@ -32,6 +33,9 @@ void LoopClosingOptions::validate() const {
   require(min_correction_deg >= 0.0, "loop_closing.min_correction_deg", ">= 0 deg");
   verification.validate();
   correction.validate();
+  require(fusion_neighbours >= 0, "loop_closing.fusion_neighbours", ">= 0 keyframes");
+  fusion.validate();
+  global_ba_options.validate();
 }
 
 namespace {
@@ -115,11 +119,52 @@ std::optional<std::vector<LoopConstraint>> confirm(const PinholeCamera& camera, 
   return constraints;
 }
 
+// One side of a loop: a keyframe and its best covisible ones.
+std::vector<KeyframeId> side_of(const Map& map, KeyframeId keyframe, int neighbours) {
+  std::vector<KeyframeId> side = {keyframe};
+  for (const KeyframeId k : map.best_covisible(keyframe, static_cast<std::size_t>(neighbours))) side.push_back(k);
+  return side;
+}
+
+// After the pose graph has brought the two sides together, the matched side's landmarks are fused into
+// the current side's keyframes: a landmark seen on both laps becomes one, which ties the laps together
+// for the bundle adjustment. Returns how many were fused.
+int fuse_across(Map& map, const PinholeCamera& camera, const LoopClosingOptions& options, KeyframeId current,
+                KeyframeId matched) {
+  const std::vector<KeyframeId> current_side = side_of(map, current, options.fusion_neighbours);
+  std::vector<KeyframeId> matched_side = side_of(map, matched, options.fusion_neighbours);
+  std::erase_if(matched_side, [&](KeyframeId k) {
+    return std::find(current_side.begin(), current_side.end(), k) != current_side.end();
+  });
+  const std::vector<LandmarkId> landmarks = map.landmarks_seen_by(matched_side);
+  int fused = 0;
+  for (const KeyframeId k : current_side) fused += fuse_landmarks(map, camera, k, landmarks, options.fusion);
+  if (fused == 0) return 0;
+  for (const LandmarkId l : map.landmarks_seen_by(current_side)) map.update_landmark(l);
+  for (const KeyframeId k : current_side) map.update_covisibility(k);
+  for (const KeyframeId k : matched_side) map.update_covisibility(k);
+  return fused;
+}
+
 }  // namespace
 
 LoopCloser::LoopCloser(const PinholeCamera& camera, LoopClosingOptions options)
     : camera_(camera), options_(std::move(options)) {
   options_.validate();
+}
+
+void LoopCloser::adjust_map(Map& map, KeyframeId keyframe, LoopClosure& closure) const {
+  const Stopwatch watch;
+  Roots roots(map);
+  const KeyframeId root = roots(keyframe);
+  std::vector<KeyframeId> tree = map.keyframe_ids();
+  std::erase_if(tree, [&](KeyframeId k) { return roots(k) != root; });
+  MapBundle bundle = make_map_bundle(map, tree, {}, root);
+  const BundleAdjustmentResult result = bundle_adjust(camera_, bundle.problem, options_.global_ba_options);
+  closure.global_ba_keyframes = static_cast<int>(bundle.keyframes.size());
+  closure.global_ba_landmarks = static_cast<int>(bundle.landmarks.size());
+  closure.global_ba_outliers = apply_map_bundle(map, bundle, result);
+  closure.global_ba_ms = watch.elapsed_ms();
 }
 
 void LoopCloser::remember(KeyframeId keyframe) {
@@ -212,15 +257,18 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
   closure.place_distance = best->place_distance;
   closure.inliers = best->verification.counts.inliers;
   closure.correction = correct_loops(map, loops_, options_.correction);
+  if (options_.fuse) closure.fused_landmarks = fuse_across(map, camera_, options_, keyframe, closure.matched);
+  if (options_.global_ba) adjust_map(map, keyframe, closure);
   const PoseChange moved = pose_change(T_cam_world_before, *map.keyframe_pose(keyframe));
   closure.correction_m = moved.m;
   closure.correction_deg = moved.deg;
   closure.time_ms = watch.elapsed_ms();
   logger()->info("loop closed: frame {} with frame {} (place {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
-                 "loop error {:.2f} -> {:.3f} m, {:.0f} ms",
+                 "loop error {:.2f} -> {:.3f} m, {} landmarks fused, global BA {} keyframes {:.0f} ms, {:.0f} ms",
                  closure.frame_index, closure.matched_frame_index, closure.place_distance, closure.inliers,
                  closure.correction_m, closure.correction_deg, closure.correction.loop_error_before_m,
-                 closure.correction.loop_error_after_m, closure.time_ms);
+                 closure.correction.loop_error_after_m, closure.fused_landmarks, closure.global_ba_keyframes,
+                 closure.global_ba_ms, closure.time_ms);
   step.closure = closure;
   return done();
 }

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <utility>
 
 namespace {
 
@@ -103,6 +104,12 @@ TEST_CASE("loop closer: a revisit of real keyframes with drift is closed and cor
   CHECK(closure->matched == originals[2]);
   CHECK(closure->correction_m > 1.0);
   CHECK(closer.loops().size() == 3);
+  // the revisits had no landmarks: fusion gives them the originals' (measured: 106 fused), and the
+  // global bundle adjustment takes every keyframe of the map
+  CHECK(closure->fused_landmarks >= 50);
+  CHECK(map.keyframe(revisits[2])->covisibility.contains(originals[2]));
+  CHECK(std::cmp_equal(closure->global_ba_keyframes, map.keyframe_count()));
+  CHECK(closure->global_ba_landmarks > 0);
   const double after = error_m(2);
   CAPTURE(before, after, error_m(0), error_m(1), closure->correction.loop_error_before_m,
           closure->correction.loop_error_after_m);
@@ -140,6 +147,15 @@ TEST_CASE("loop closing options are checked, naming the field") {
   o = {};
   o.scan_context.sectors = 1;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("scan_context.sectors"));
+  o = {};
+  o.fusion_neighbours = -1;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_closing.fusion_neighbours"));
+  o = {};
+  o.fusion.radius_px = 0.0;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("fusion.radius_px"));
+  o = {};
+  o.global_ba_options.iterations = 0;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("bundle_adjustment.iterations"));
   rgbl::SystemOptions s;
   s.loop_closing.min_correction_m = -1.0;
   CHECK_THROWS_WITH(s.validate(), Catch::Contains("loop_closing.min_correction_m"));

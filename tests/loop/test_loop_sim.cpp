@@ -81,7 +81,9 @@ TEST_CASE("loop closer: two laps of the simulator's loop are closed where the pl
   }
   fmt::print("two laps of a 100 m loop: {} closures, ATE {:.3f} m (without loop closing {:.3f} m)\n", closures, with.ate,
              without.ate);
-  // measured: 3 closures, ATE 0.231 m against 1.438 m
+  // measured: 1 closure (the map agrees with the loop afterwards), ATE 0.079 m against 1.438 m; with the
+  // pose graph alone (no fusion, no global bundle adjustment) it was 3 closures and 0.231 m
   CHECK(closures >= 1);
-  CHECK(with.ate < 0.3 * without.ate);
+  CHECK(with.ate < 0.12);
+  CHECK(with.ate < 0.1 * without.ate);
 }

@@ -4,9 +4,9 @@
 // landmark moves rigidly with its reference keyframe. Frames tracked against a keyframe follow it, so
 // trajectories written after the correction are the corrected ones.
 //
-// What is not here (issue 14): finding the loop (place recognition), verifying it and measuring
-// T_current_matched, fusing the duplicated landmarks across the loop, the global bundle adjustment
-// that follows.
+// Not here: finding and verifying the loop (rgbl/loop), fusing the landmarks across it
+// (rgbl/map/fusion.hpp) and the bundle adjustment of the whole map that follows (map_bundle.hpp); the
+// LoopCloser runs them in that order.
 
 #include "rgbl/backend/pose_graph.hpp"
 #include "rgbl/map/map.hpp"

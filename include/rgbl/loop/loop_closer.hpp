@@ -5,13 +5,20 @@
 // optimisation over the essential graph (keyframes and landmarks move together; frames tracked
 // against a keyframe follow it).
 //
-// Not here yet (issue 14): a bag of words for depth sources without a scan, landmark fusion across the
-// loop, the global bundle adjustment, map merging, a thread of its own.
+// After the pose graph, the landmarks seen on one side of the loop are fused with those on the other
+// (the loop's duplicates become one landmark, observed from both laps), and a bundle adjustment of
+// the whole map (of the closing keyframe's spanning tree) then refines every keyframe and landmark
+// against all observations, old lap and new.
+//
+// Not here yet (issue 14): a bag of words for depth sources without a scan, map merging, a thread of
+// its own.
 
+#include "rgbl/backend/bundle_adjustment.hpp"
 #include "rgbl/backend/loop_correction.hpp"
 #include "rgbl/geometry/camera.hpp"
 #include "rgbl/geometry/point_cloud.hpp"
 #include "rgbl/loop/verification.hpp"
+#include "rgbl/map/fusion.hpp"
 #include "rgbl/map/map.hpp"
 #include "rgbl/place/scan_context.hpp"
 
@@ -45,6 +52,14 @@ struct LoopClosingOptions {
   double min_correction_deg = 0.5;
   LoopVerificationOptions verification;
   LoopCorrectionOptions correction;
+  // Fusion across the loop: the landmarks of the matched keyframe and its fusion_neighbours best
+  // covisible ones are fused into the closing keyframe and its fusion_neighbours best covisible ones.
+  bool fuse = true;
+  int fusion_neighbours = 10;
+  FusionOptions fusion;
+  // Bundle adjustment of the whole map after a closure (its spanning-tree root held fixed).
+  bool global_ba = true;
+  BundleAdjustmentOptions global_ba_options = {.iterations = 10, .dense_schur = false};
 
   void validate() const;
 };
@@ -60,6 +75,11 @@ struct LoopClosure {
   double correction_deg = 0.0;          // and turned
   double time_ms = 0.0;                 // detection, verification and correction of this keyframe
   LoopCorrectionResult correction;
+  int fused_landmarks = 0;              // duplicates across the loop made one, observations added
+  int global_ba_keyframes = 0;          // keyframes and landmarks in the global bundle adjustment
+  int global_ba_landmarks = 0;
+  int global_ba_outliers = 0;           // observations it erased
+  double global_ba_ms = 0.0;
 };
 
 // What one keyframe did in the loop closer (also when nothing was closed).
@@ -92,6 +112,7 @@ class LoopCloser {
   // The latest consistent_keyframes keyframes processed, oldest first (one spare for a culled one).
   std::vector<KeyframeId> recent_;
   void remember(KeyframeId keyframe);
+  void adjust_map(Map& map, KeyframeId keyframe, LoopClosure& closure) const;
 };
 
 }  // namespace rgbl
