@@ -1,9 +1,9 @@
 #include "rgbl/loop/loop_closer.hpp"
 
+#include "rgbl/backend/map_bundle.hpp"
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/log.hpp"
 #include "rgbl/core/timer.hpp"
-#include "rgbl/backend/map_bundle.hpp"
 #include "rgbl/geometry/se3.hpp"
 
 #include <Eigen/Geometry>
@@ -119,20 +119,14 @@ std::optional<std::vector<LoopConstraint>> confirm(const PinholeCamera& camera, 
   return constraints;
 }
 
-// One side of a loop: a keyframe and its best covisible ones.
-std::vector<KeyframeId> side_of(const Map& map, KeyframeId keyframe, int neighbours) {
-  std::vector<KeyframeId> side = {keyframe};
-  for (const KeyframeId k : map.best_covisible(keyframe, static_cast<std::size_t>(neighbours))) side.push_back(k);
-  return side;
-}
-
 // After the pose graph has brought the two sides together, the matched side's landmarks are fused into
 // the current side's keyframes: a landmark seen on both laps becomes one, which ties the laps together
 // for the bundle adjustment. Returns how many were fused.
 int fuse_across(Map& map, const PinholeCamera& camera, const LoopClosingOptions& options, KeyframeId current,
                 KeyframeId matched) {
-  const std::vector<KeyframeId> current_side = side_of(map, current, options.fusion_neighbours);
-  std::vector<KeyframeId> matched_side = side_of(map, matched, options.fusion_neighbours);
+  const auto neighbours = static_cast<std::size_t>(options.fusion_neighbours);
+  const std::vector<KeyframeId> current_side = map.neighbourhood(current, neighbours);
+  std::vector<KeyframeId> matched_side = map.neighbourhood(matched, neighbours);
   std::erase_if(matched_side, [&](KeyframeId k) {
     return std::find(current_side.begin(), current_side.end(), k) != current_side.end();
   });

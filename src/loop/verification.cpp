@@ -24,9 +24,7 @@ struct PointMatch {
 
 // Where a loop is looked for: the landmarks of the candidate and of its best covisible keyframes.
 std::vector<LandmarkId> region_landmarks(const Map& map, KeyframeId candidate, std::size_t neighbours) {
-  std::vector<KeyframeId> around{candidate};
-  for (const KeyframeId id : map.best_covisible(candidate, neighbours)) around.push_back(id);
-  return map.landmarks_seen_by(around);
+  return map.landmarks_seen_by(map.neighbourhood(candidate, neighbours));
 }
 
 // What one verification works on: the current keyframe against the candidate's region.

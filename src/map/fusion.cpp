@@ -2,6 +2,7 @@
 
 #include "rgbl/core/error.hpp"
 #include "rgbl/features/matcher.hpp"
+#include "rgbl/map/landmark_view.hpp"
 
 #include <algorithm>
 #include <climits>
@@ -13,6 +14,7 @@ namespace rgbl {
 void FusionOptions::validate() const {
   require(radius_px > 0.0, "fusion.radius_px", "> 0 px");
   require(max_hamming >= 0 && max_hamming <= 256, "fusion.max_hamming", "a Hamming distance in [0, 256]");
+  require(min_view_cos >= -1.0 && min_view_cos <= 1.0, "fusion.min_view_cos", "a cosine in [-1, 1]");
 }
 
 int fuse_landmarks(Map& map, const PinholeCamera& camera, KeyframeId target_id, std::span<const LandmarkId> landmarks,
@@ -22,7 +24,6 @@ int fuse_landmarks(Map& map, const PinholeCamera& camera, KeyframeId target_id, 
   const FeatureGrid grid(target->keypoints, camera.width, camera.height);
   const Eigen::Vector3d center = target->center();
   const double scale = map.options().scale_factor;
-  const int levels = map.options().levels;
   constexpr double kChi2Pixel = 5.991, kChi2PixelDepth = 7.815;  // 95 % for 2 and 3 dof
   std::vector<int> cell;
   int fused = 0;
@@ -30,27 +31,20 @@ int fuse_landmarks(Map& map, const PinholeCamera& camera, KeyframeId target_id, 
     const Landmark* l = map.landmark(id);
     target = map.keyframe(target_id);  // merging below may have changed the keyframe's slots
     if (l == nullptr || target == nullptr || l->observations.count(target_id) != 0) continue;
-    const Eigen::Vector3d p = target->T_cam_world * l->position;
-    if (p.z() <= 0.0) continue;
-    const Eigen::Vector2d px = camera.project_unchecked(p);
-    if (!camera.in_image(px)) continue;
-    const Eigen::Vector3d ray = l->position - center;
-    const double distance = ray.norm();
-    if (distance < 0.8 * l->min_distance || distance > 1.2 * l->max_distance) continue;
-    if (ray.dot(l->normal) < 0.5 * distance) continue;
-    const int level = l->predict_level(distance, levels, scale);
-    const double radius = options.radius_px * std::pow(scale, level);
-    grid.query(static_cast<float>(px.x()), static_cast<float>(px.y()), static_cast<float>(radius),
-               std::max(0, level - 1), level, cell);
+    const auto view = view_landmark(*l, target->T_cam_world, center, camera, map.options(), options.min_view_cos);
+    if (!view) continue;
+    const double radius = options.radius_px * std::pow(scale, view->level);
+    grid.query(static_cast<float>(view->pixel.x()), static_cast<float>(view->pixel.y()), static_cast<float>(radius),
+               std::max(0, view->level - 1), view->level, cell);
     int best = INT_MAX, best_index = -1;
     for (const int k : cell) {
       const auto ks = static_cast<std::size_t>(k);
       const Keypoint& kp = target->keypoints[ks];
       const double sigma = std::pow(scale, kp.level);
-      double chi2 = (Eigen::Vector2d(kp.x, kp.y) - px).squaredNorm() / (sigma * sigma);
+      double chi2 = (Eigen::Vector2d(kp.x, kp.y) - view->pixel).squaredNorm() / (sigma * sigma);
       double threshold = kChi2Pixel;
       if (target->depth_sigma[ks] > 0.0F) {
-        const double dz = (p.z() - target->depth[ks]) / target->depth_sigma[ks];
+        const double dz = (view->p_cam.z() - target->depth[ks]) / target->depth_sigma[ks];
         chi2 += dz * dz;
         threshold = kChi2PixelDepth;
       }

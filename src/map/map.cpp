@@ -238,6 +238,12 @@ std::vector<KeyframeId> Map::best_covisible(KeyframeId keyframe_id, std::size_t 
   return out;
 }
 
+std::vector<KeyframeId> Map::neighbourhood(KeyframeId keyframe, std::size_t n) const {
+  std::vector<KeyframeId> window = {keyframe};
+  for (const KeyframeId k : best_covisible(keyframe, n)) window.push_back(k);
+  return window;
+}
+
 Keyframe* Map::keyframe(KeyframeId id) {
   if (!id.valid() || static_cast<std::size_t>(id.value) >= keyframes_.size()) return nullptr;
   auto& slot = keyframes_[static_cast<std::size_t>(id.value)];

@@ -87,10 +87,6 @@ int LocalMapper::create_depth_landmarks(KeyframeId id) {
   return created;
 }
 
-int LocalMapper::fuse_into(KeyframeId target, const std::vector<LandmarkId>& landmarks) {
-  return fuse_landmarks(map_, camera_, target, landmarks, options_.fusion_match);
-}
-
 int LocalMapper::fuse(KeyframeId id) {
   std::vector<KeyframeId> targets = map_.best_covisible(id, static_cast<std::size_t>(options_.covisible_for_fusion));
   const std::size_t direct = targets.size();
@@ -107,9 +103,9 @@ int LocalMapper::fuse(KeyframeId id) {
     for (const LandmarkId l : kf->landmarks) {
       if (l.valid()) own.push_back(l);
     }
-    for (const KeyframeId t : targets) fused += fuse_into(t, own);
+    for (const KeyframeId t : targets) fused += fuse_landmarks(map_, camera_, t, own, options_.fusion_match);
   }
-  fused += fuse_into(id, map_.landmarks_seen_by(targets));
+  fused += fuse_landmarks(map_, camera_, id, map_.landmarks_seen_by(targets), options_.fusion_match);
   if (const Keyframe* kf = map_.keyframe(id)) {
     for (const LandmarkId l : kf->landmarks) {
       if (l.valid()) map_.update_landmark(l);
@@ -126,10 +122,8 @@ int LocalMapper::local_bundle_adjustment(KeyframeId id, double& elapsed_ms) {
   {
     std::shared_lock lock(map_.mutex());
     if (map_.keyframe(id) == nullptr) return 0;
-    std::vector<KeyframeId> local = {id};
-    for (const KeyframeId k : map_.best_covisible(id, static_cast<std::size_t>(options_.max_local_ba_keyframes - 1))) {
-      local.push_back(k);
-    }
+    const std::vector<KeyframeId> local =
+        map_.neighbourhood(id, static_cast<std::size_t>(options_.max_local_ba_keyframes - 1));
     // Fixed keyframes: those outside the window that see the most local landmarks.
     std::map<KeyframeId, int> outside;
     for (const LandmarkId l : map_.landmarks_seen_by(local)) {

@@ -4,6 +4,7 @@
 #include "rgbl/backend/pose_optimizer.hpp"
 #include "rgbl/core/log.hpp"
 #include "rgbl/geometry/se3.hpp"
+#include "rgbl/map/landmark_view.hpp"
 #include "rgbl/tracking/frame_motion.hpp"
 
 #include <opencv2/calib3d.hpp>
@@ -529,31 +530,23 @@ Tracker::LocalMapResult Tracker::track_local_map(Frame& frame) {
     std::sort(matched.begin(), matched.end());
     const Eigen::Isometry3d T_world_cam = frame.T_cam_world.inverse();
     const Eigen::Vector3d center = T_world_cam.translation();
-    const int levels = map_.options().levels;
-    const double scale = map_.options().scale_factor;
+    const MapOptions& map_options = map_.options();
     for (const LandmarkId id : local_landmarks_) {
       if (std::binary_search(matched.begin(), matched.end(), id)) continue;
       const Landmark* l = map_.landmark(id);
       if (l == nullptr) continue;
-      const Eigen::Vector3d p = frame.T_cam_world * l->position;
-      if (p.z() <= 0.0) continue;
-      const Eigen::Vector2d px = camera_.project_unchecked(p);
-      if (!camera_.in_image(px)) continue;
-      const Eigen::Vector3d ray = l->position - center;
-      const double distance = ray.norm();
-      if (distance < 0.8 * l->min_distance || distance > 1.2 * l->max_distance) continue;
-      if (ray.dot(l->normal) < options_.min_view_cos * distance) continue;
-      const int level = l->predict_level(distance, levels, scale);
+      const auto view = view_landmark(*l, frame.T_cam_world, center, camera_, map_options, options_.min_view_cos);
+      if (!view) continue;
       visible.push_back(id);
       detail::ProjectedLandmark c;
       c.id = id;
       c.descriptor = l->descriptor;
-      c.x = static_cast<float>(px.x());
-      c.y = static_cast<float>(px.y());
-      c.radius = static_cast<float>(options_.local_map_radius * std::pow(scale, level));
-      c.min_level = std::max(0, level - 1);
-      c.max_level = level;
-      c.depth = static_cast<float>(p.z());
+      c.x = static_cast<float>(view->pixel.x());
+      c.y = static_cast<float>(view->pixel.y());
+      c.radius = static_cast<float>(options_.local_map_radius * std::pow(map_options.scale_factor, view->level));
+      c.min_level = std::max(0, view->level - 1);
+      c.max_level = view->level;
+      c.depth = static_cast<float>(view->p_cam.z());
       candidates.push_back(c);
     }
     const detail::DepthGate gate{static_cast<float>(options_.depth_gate_sigmas),

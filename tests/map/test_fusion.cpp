@@ -2,8 +2,11 @@
 
 #include "rgbl/core/error.hpp"
 #include "rgbl/map/fusion.hpp"
+#include "rgbl/map/landmark_view.hpp"
 
 #include <catch2/catch.hpp>
+
+#include <cmath>
 
 namespace {
 
@@ -97,4 +100,46 @@ TEST_CASE("fusion: options are checked") {
   o = {};
   o.max_hamming = 300;
   CHECK_THROWS_AS(o.validate(), rgbl::ConfigError);
+  o = {};
+  o.min_view_cos = 1.5;
+  CHECK_THROWS_AS(o.validate(), rgbl::ConfigError);
+}
+
+TEST_CASE("landmark view: pixel, distance and level where it is visible, nothing where it is not") {
+  const rgbl::PinholeCamera camera{.fx = 500.0, .fy = 500.0, .cx = 320.0, .cy = 240.0, .width = 640, .height = 480};
+  const rgbl::MapOptions map_options;  // 8 levels, scale 1.2
+  rgbl::Landmark l;
+  l.position = Eigen::Vector3d(1.0, 0.5, 10.0);
+  l.normal = Eigen::Vector3d::UnitZ();  // it was seen looking along +z
+  l.min_distance = 5.0;
+  l.max_distance = 20.0;
+  const Eigen::Isometry3d at_origin = Eigen::Isometry3d::Identity();
+  const auto seen = rgbl::view_landmark(l, at_origin, Eigen::Vector3d::Zero(), camera, map_options, 0.5);
+  REQUIRE(seen.has_value());
+  CHECK(seen->pixel.x() == Approx(370.0));
+  CHECK(seen->pixel.y() == Approx(265.0));
+  CHECK(seen->distance == Approx(l.position.norm()));
+  CHECK(seen->level == l.predict_level(seen->distance, map_options.levels, map_options.scale_factor));
+
+  // behind the camera: turned round
+  Eigen::Isometry3d turned = Eigen::Isometry3d::Identity();
+  turned.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  CHECK_FALSE(rgbl::view_landmark(l, turned, Eigen::Vector3d::Zero(), camera, map_options, 0.5));
+  // too near for the distances it was seen from (0.8 x 5 m = 4 m): a camera 7 m closer
+  Eigen::Isometry3d near = Eigen::Isometry3d::Identity();
+  near.translation() = Eigen::Vector3d(0.0, 0.0, -7.0);
+  CHECK_FALSE(rgbl::view_landmark(l, near, Eigen::Vector3d(0.0, 0.0, 7.0), camera, map_options, 0.5));
+  // seen from 70 deg off its viewing direction (cos 0.34), looking straight at it from 10 m: refused at
+  // min_view_cos 0.5, taken at 0.3
+  const double angle = 70.0 * M_PI / 180.0;
+  Eigen::Isometry3d T_world_side = Eigen::Isometry3d::Identity();
+  T_world_side.linear() = Eigen::AngleAxisd(-angle, Eigen::Vector3d::UnitY()).toRotationMatrix();  // z to the landmark
+  const Eigen::Vector3d side = l.position - 10.0 * T_world_side.linear().col(2);
+  T_world_side.translation() = side;
+  CHECK_FALSE(rgbl::view_landmark(l, T_world_side.inverse(), side, camera, map_options, 0.5));
+  const auto oblique = rgbl::view_landmark(l, T_world_side.inverse(), side, camera, map_options, 0.3);
+  REQUIRE(oblique.has_value());
+  CHECK(oblique->pixel.x() == Approx(320.0));
+  CHECK(oblique->pixel.y() == Approx(240.0));
+  CHECK(oblique->distance == Approx(10.0));
 }

@@ -47,6 +47,8 @@ TEST_CASE("map: observations, covisibility and spanning tree") {
   CHECK(map.keyframe(a)->covisibility.at(c) == 1);
   CHECK(map.best_covisible(b, 1) == std::vector<rgbl::KeyframeId>{a});
   CHECK(map.best_covisible(b, 5, 2) == std::vector<rgbl::KeyframeId>{a, c});
+  CHECK(map.neighbourhood(b, 5) == std::vector<rgbl::KeyframeId>{b, a, c});
+  CHECK(map.neighbourhood(c, 1) == std::vector<rgbl::KeyframeId>{c, b});
   CHECK(map.keyframe(b)->parent == a);
   CHECK(map.keyframe(c)->parent == b);
   CHECK(map.keyframe(b)->landmark_count() == 6);

@@ -1,6 +1,6 @@
 #pragma once
 // Bundle adjustment of (part of) a Map: the problem is built from keyframes and the landmarks they
-// observe, solved by bundle_adjust without the map lock (the solve works on copies), and written
+// observe, solved by bundle_adjust (on copies, so the solve itself needs no map lock), and written
 // back. Local mapping adjusts a keyframe's neighbourhood; loop closing adjusts the whole map.
 
 #include "rgbl/backend/bundle_adjustment.hpp"

@@ -14,14 +14,14 @@ namespace rgbl {
 struct FusionOptions {
   double radius_px = 3.0;  // search radius at pyramid level 0, scaled by scale_factor^level
   int max_hamming = 50;    // descriptor distance of an accepted match
+  double min_view_cos = 0.5;  // viewing direction within 60 deg of the landmark's mean one
 
   void validate() const;
 };
 
 // Fuses `landmarks` into keyframe `target`; returns how many were fused (observations added or
 // duplicates merged). When two landmarks merge, the one with more observations survives. Landmarks
-// the target already observes, behind it, outside the image, outside their distance range or seen
-// from more than 60 deg off their mean viewing direction are skipped. Call with the map's lock held
+// the target already observes or cannot see (view_landmark with options.min_view_cos) are skipped. Call with the map's lock held
 // exclusively. Does not recompute descriptors or covisibility: the caller does, once, afterwards.
 int fuse_landmarks(Map& map, const PinholeCamera& camera, KeyframeId target, std::span<const LandmarkId> landmarks,
                    const FusionOptions& options = {});

@@ -107,6 +107,9 @@ class Map {
   void update_covisibility(KeyframeId keyframe);
   // The n neighbours with the largest weights, strongest first (ties by id).
   std::vector<KeyframeId> best_covisible(KeyframeId keyframe, std::size_t n, int min_weight = 1) const;
+  // The keyframe itself followed by its n best covisible ones: the window local BA adjusts and the
+  // region loop closing searches and fuses.
+  std::vector<KeyframeId> neighbourhood(KeyframeId keyframe, std::size_t n) const;
 
   Keyframe* keyframe(KeyframeId id);
   const Keyframe* keyframe(KeyframeId id) const;

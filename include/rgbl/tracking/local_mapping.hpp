@@ -36,7 +36,6 @@ class LocalMapper {
   int create_depth_landmarks(KeyframeId keyframe);
   int cull_landmarks(KeyframeId keyframe);
   int fuse(KeyframeId keyframe);
-  int fuse_into(KeyframeId target, const std::vector<LandmarkId>& landmarks);
   int local_bundle_adjustment(KeyframeId keyframe, double& elapsed_ms);
   int cull_keyframes(KeyframeId keyframe);
 
