@@ -131,12 +131,20 @@ void suburban(SyntheticOptions& o, Rng& rng) {
   o.actors.push_back(car);
 }
 
+// A straight street of identical 100 m blocks (buildings, parked cars, poles, trees, markings; only the
+// asphalt differs): every block scans and looks like the one before, so place recognition finds a
+// convincing loop every 100 m that is not one. Three blocks.
+void repeated(SyntheticOptions& o, Rng&) {
+  o.path.kind = PathKind::straight;
+  o.scene.repeat_length = 100.0;
+}
+
 struct Entry {
   ScenarioInfo info;
   void (*build)(SyntheticOptions&, Rng&);
 };
 
-constexpr std::array<Entry, 7> kScenarios{{
+constexpr std::array<Entry, 8> kScenarios{{
     {{"plain", "the reference street: 30 m straight, a gentle 60 deg bend (radius 40 m), 10 m/s", 60}, plain},
     {{"lead-vehicle", "a van 6 m ahead in the ego lane at the ego speed for the whole run (10-25 % of the image)", 60},
      lead_vehicle},
@@ -154,6 +162,9 @@ constexpr std::array<Entry, 7> kScenarios{{
       "40 frames, a gentle curve",
       100},
      suburban},
+    {{"repeated", "a straight street of identical 100 m blocks: a false loop every block for place recognition to refuse",
+      300},
+     repeated},
 }};
 
 }  // namespace

@@ -185,6 +185,8 @@ void StreetOptions::validate() const {
   require(hedge_height >= 0.0 && hedge_height <= 10.0, "scene.hedge_height", "a height in [0, 10] m (0 = no hedge)");
   require(hedge_offset >= 0.0 && hedge_depth >= 0.1 && hedge_offset + hedge_depth <= sidewalk_width,
           "scene.hedge_offset", "hedge_offset >= 0, hedge_depth >= 0.1 m, both within the sidewalk");
+  require(repeat_length == 0.0 || repeat_length >= 20.0, "scene.repeat_length",
+          "0 (no repetition) or a block of at least 20 m");
 }
 
 bool intersect_object(const SceneObject& ob, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
@@ -522,7 +524,50 @@ StreetScene::StreetScene(const DrivePath& path, const StreetOptions& options, st
                                      0.5 * chord.norm() + 0.05, 0.5 * o.hedge_depth, ground_y_, 0.0, height));
     }
   }
+  if (o.repeat_length > 0.0) repeat_blocks(path, s_begin, s_end, o.repeat_length);
   build_grid();
+}
+
+void StreetScene::repeat_blocks(const DrivePath& path, double s_begin, double s_end, double period) {
+  const PathPoint start = path.at(s_begin);
+  require(!path.closed() && path.at(s_end).heading == start.heading &&
+              path.at(0.5 * (s_begin + s_end)).heading == start.heading,
+          "scene.repeat_length", "a straight path (blocks repeat by translation)");
+  const Eigen::Vector2d forward = start.forward(), origin(start.x, start.z);
+  const auto along = [&](double x, double z) { return (Eigen::Vector2d(x, z) - origin).dot(forward); };
+  // The block: objects wholly inside [0, period) along the street, markings centred there.
+  std::vector<SceneObject> block;
+  for (const SceneObject& ob : objects_) {
+    const double reach = std::abs(ob.ax * forward.x() + ob.az * forward.y()) * ob.hx +
+                         std::abs(-ob.az * forward.x() + ob.ax * forward.y()) * ob.hz;
+    const double a = along(ob.cx, ob.cz);
+    if (a - reach >= 0.0 && a + reach < period) block.push_back(ob);
+  }
+  std::vector<GroundDecal> markings, surface;
+  for (const GroundDecal& d : decals_) {
+    if (d.kind != SurfaceKind::marking) {
+      surface.push_back(d);
+    } else if (const double a = along(d.cx, d.cz); a >= 0.0 && a < period) {
+      markings.push_back(d);
+    }
+  }
+  objects_.clear();
+  decals_.clear();
+  const int last = static_cast<int>(std::ceil((s_end - s_begin) / period)) + 1;
+  for (int k = -1; k <= last; ++k) {
+    const Eigen::Vector2d shift = k * period * forward;
+    for (SceneObject ob : block) {
+      ob.cx += shift.x();
+      ob.cz += shift.y();
+      objects_.push_back(ob);
+    }
+    for (GroundDecal d : markings) {
+      d.cx += shift.x();
+      d.cz += shift.y();
+      decals_.push_back(d);
+    }
+  }
+  decals_.insert(decals_.end(), surface.begin(), surface.end());  // markings first
 }
 
 StreetScene::StreetScene(std::vector<SceneObject> objects, std::vector<GroundDecal> decals, double ground_y)

@@ -109,7 +109,7 @@ TEST_CASE("the scenario registry lists every scenario, each with its options and
     CHECK(rgbl::scenario_options(s.name, 3, 20).frames == 20);
   }
   CHECK(list.front().name == "plain");
-  for (const char* required : {"plain", "lead-vehicle", "traffic", "foliage", "shadows", "turn", "suburban"}) {
+  for (const char* required : {"plain", "lead-vehicle", "traffic", "foliage", "shadows", "turn", "suburban", "repeated"}) {
     CHECK(names.count(required) == 1);
   }
   try {

@@ -1,3 +1,4 @@
+#include "rgbl/core/error.hpp"
 #include "rgbl/sim/scene.hpp"
 #include "rgbl/sim/synthetic.hpp"
 
@@ -169,4 +170,58 @@ TEST_CASE("the street: facades on both sides, parked cars, poles, and a clear dr
     const auto kind_below = scene.surface(*hit, generator.pose(10).translation(), down).kind;
     CHECK((kind_below == rgbl::SurfaceKind::road || kind_below == rgbl::SurfaceKind::marking));
   }
+}
+
+TEST_CASE("a street of identical blocks: every ray meets the same surface one block on, only on a straight path") {
+  rgbl::SyntheticOptions options;
+  options.path.kind = rgbl::PathKind::straight;
+  options.frames = 250;
+  options.scene.repeat_length = 100.0;
+  const rgbl::SyntheticGenerator generator(options);
+  const rgbl::StreetScene& scene = generator.scene();
+  int facades = 0, cars = 0;
+  for (const auto& o : scene.objects()) {
+    facades += o.kind == rgbl::SurfaceKind::facade ? 1 : 0;
+    cars += o.kind == rgbl::SurfaceKind::car ? 1 : 0;
+  }
+  CHECK(facades >= 8);
+  CHECK(cars >= 10);
+  // Rays from frame 20 and from 100 m further on (frame 120 at 10 m/s) in the same directions: the
+  // same object kind, seed, face and surface coordinates, at the same distance; the ground differs
+  // only in the asphalt's texture, which is not the scene's business here.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> angle(-1.2, 1.2), pitch(-0.3, 0.25);
+  const Eigen::Vector3d a = generator.pose(20).translation(), b = generator.pose(120).translation();
+  REQUIRE_THAT((b - a).norm(), WithinAbs(100.0, 1e-9));
+  int objects_hit = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const double yaw = angle(rng), tilt = pitch(rng);
+    const Eigen::Vector3d d(std::sin(yaw) * std::cos(tilt), tilt, std::cos(yaw) * std::cos(tilt));
+    const auto ha = scene.intersect(a, d, 80.0), hb = scene.intersect(b, d, 80.0);
+    REQUIRE(ha.has_value() == hb.has_value());
+    if (!ha) continue;
+    CHECK_THAT(hb->t, WithinAbs(ha->t, 1e-6));
+    if (ha->object == rgbl::StreetScene::kGround) {
+      CHECK(hb->object == rgbl::StreetScene::kGround);
+      continue;
+    }
+    ++objects_hit;
+    const rgbl::SurfacePoint sa = scene.surface(*ha, a, d), sb = scene.surface(*hb, b, d);
+    CHECK(sa.kind == sb.kind);
+    CHECK(sa.seed == sb.seed);
+    CHECK(sa.face == sb.face);
+    CHECK_THAT(sb.u, WithinAbs(sa.u, 1e-6));
+    CHECK_THAT(sb.v, WithinAbs(sa.v, 1e-6));
+  }
+  CHECK(objects_hit > 800);
+
+  options.path.kind = rgbl::PathKind::curve;
+  try {
+    const rgbl::SyntheticGenerator curved(options);
+    FAIL("identical blocks were laid along a curve");
+  } catch (const rgbl::ConfigError& e) {
+    CHECK(e.key() == "scene.repeat_length");
+  }
+  options.scene.repeat_length = 10.0;
+  CHECK_THROWS_AS(options.scene.validate(), rgbl::ConfigError);
 }

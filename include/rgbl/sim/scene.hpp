@@ -37,6 +37,11 @@ struct StreetOptions {
   double hedge_height = 0.0;      // m, mean height (it varies by +-15 % from piece to piece)
   double hedge_offset = 0.3;      // m, kerb to the hedge's road-side face
   double hedge_depth = 1.2;       // m
+  // A street of identical blocks (0 = none): what stands wholly within the first repeat_length metres,
+  // and the markings there, are copied every repeat_length metres with their seeds, so every block
+  // looks and scans exactly like the others (only the asphalt's texture follows the world). A straight
+  // path only. Built to tempt place recognition into a false loop.
+  double repeat_length = 0.0;     // m
 
   void validate() const;
 };
@@ -115,6 +120,7 @@ class StreetScene {
 
  private:
   void build_grid();
+  void repeat_blocks(const DrivePath& path, double s_begin, double s_end, double period);
   SurfaceKind ground_kind(double x, double z) const;
 
   std::vector<SceneObject> objects_;
