@@ -22,6 +22,7 @@
 #include <mutex>
 #include <shared_mutex>
 #include <system_error>
+#include <unordered_map>
 #include <vector>
 
 namespace rgbl::cli {
@@ -224,9 +225,23 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
       e.positions.push_back(ok ? Eigen::Vector3d(estimate.poses[i].translation())
                                : Eigen::Vector3d::Constant(std::nan("")));
     }
+    // each loop closure joins its frame to the frame it matched, both as finally estimated
+    std::vector<PlotLink> links;
+    std::unordered_map<std::size_t, std::size_t> row_of_frame;  // dataset frame index -> trajectory row
+    for (std::size_t i = 0; i < records.size() && i < estimate.poses.size(); ++i) {
+      row_of_frame[records[i].result.frame_index] = i;
+    }
+    for (std::size_t i = 0; i < records.size() && i < estimate.poses.size(); ++i) {
+      const auto& c = records[i].result.loop_closure;
+      if (!c) continue;
+      const auto matched = row_of_frame.find(c->matched_frame_index);
+      if (matched == row_of_frame.end()) continue;
+      links.push_back({estimate.poses[i].translation(), estimate.poses[matched->second].translation(),
+                       fmt::format("{}-{}", c->frame_index, c->matched_frame_index)});
+    }
     series.push_back(std::move(e));
     write_trajectory_svg(out_dir / "trajectory.svg", series,
-                         fmt::format("{}: camera {}, depth {}", p.sequence->name(), p.camera, p.depth_name));
+                         fmt::format("{}: camera {}, depth {}", p.sequence->name(), p.camera, p.depth_name), links);
   }
 
   // the map: landmarks and keyframe poses, in the same world frame as the trajectory files
@@ -303,6 +318,7 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
         c.global_ba_outliers, json_number(c.global_ba_ms), json_number(c.time_ms));
   }
   if (!loop_closures.empty()) loop_closures += "\n  ";
+  const LoopClosingStats loop_stats = system.loop_statistics();
   {
     const auto file = out_dir / "summary.json";
     std::ofstream json(file);
@@ -321,6 +337,10 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
                         out.landmarks)
          << fmt::format("  \"loop_closing\": {},\n  \"loop_closures\": [{}],\n",
                         system.loop_closing() ? "true" : "false", loop_closures)
+         << fmt::format("  \"loop_candidates\": {{\"keyframes\": {}, \"candidates\": {}, \"verified\": {}, "
+                        "\"implausible\": {}, \"consistent\": {}, \"confirming\": {}, \"closures\": {}}},\n",
+                        loop_stats.keyframes, loop_stats.candidates, loop_stats.verified, loop_stats.implausible,
+                        loop_stats.consistent, loop_stats.confirming, loop_stats.closures)
          << fmt::format("  \"threaded_mapping\": {},\n  \"wall_s\": {},\n", threaded ? "true" : "false",
                         json_number(out.wall_s))
          << "  \"stage_ms\": {\n    " << stage_json("io_wait", stats(io_ms)) << ",\n    "
@@ -339,6 +359,10 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
              out.weak, out.lost, out.not_initialised, out.keyframes, out.landmarks);
   if (!jump_frames.empty()) fmt::print("  steps beyond a vehicle's reach taken at frame(s) {}\n", jump_frames);
   if (!new_map_frames.empty()) fmt::print("  lost beyond relocalisation: new map started at frame(s) {}\n", new_map_frames);
+  if (loop_stats.implausible > 0) {
+    fmt::print("  loop closing refused {} verified loop(s) asking for more correction than odometry can drift\n",
+               loop_stats.implausible);
+  }
   for (const LoopClosure* c : closures) {
     fmt::print("  loop closed at frame {} with frame {}: map moved {:.2f} m / {:.2f} deg there, {} landmarks fused, "
                "{:.0f} ms (global BA of {} keyframes {:.0f} ms)\n",

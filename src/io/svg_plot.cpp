@@ -38,7 +38,8 @@ double grid_step(double span, int target) {
 
 }  // namespace
 
-std::string trajectory_svg(const std::vector<PlotSeries>& series, const std::string& title) {
+std::string trajectory_svg(const std::vector<PlotSeries>& series, const std::string& title,
+                           const std::vector<PlotLink>& links, const std::string& links_label) {
   constexpr double kWidth = 800.0, kHeight = 800.0, kMargin = 60.0;
   double min_x = std::numeric_limits<double>::infinity(), max_x = -min_x;
   double min_z = min_x, max_z = -min_x;
@@ -127,15 +128,33 @@ std::string trajectory_svg(const std::vector<PlotSeries>& series, const std::str
                        kMargin, ly, kMargin + 25.0, ly, color, s.dashed ? " stroke-dasharray=\"6 4\"" : "",
                        kMargin + 32.0, ly + 4.0, escape_xml(s.label));
   }
+  constexpr const char* kLinkColor = "#2ca02c";
+  for (const PlotLink& link : links) {
+    if (!link.from.allFinite() || !link.to.allFinite()) continue;
+    const auto [fx, fy] = to_px(link.from.x(), link.from.z());
+    const auto [tx, ty] = to_px(link.to.x(), link.to.z());
+    svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\" stroke-width=\"2\"/>"
+                       "<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>"
+                       "<text x=\"{:.1f}\" y=\"{:.1f}\" fill=\"{}\">{}</text>\n",
+                       fx, fy, tx, ty, kLinkColor, fx, fy, kLinkColor, fx + 7.0, fy - 7.0, kLinkColor,
+                       escape_xml(link.label));
+  }
+  if (!links.empty()) {
+    const double ly = 55.0 + 18.0 * static_cast<double>(series.size());
+    svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\" "
+                       "stroke-width=\"3\"/><text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n",
+                       kMargin, ly, kMargin + 25.0, ly, kLinkColor, kMargin + 32.0, ly + 4.0, escape_xml(links_label));
+  }
   svg += "</svg>\n";
   return svg;
 }
 
 void write_trajectory_svg(const std::filesystem::path& path, const std::vector<PlotSeries>& series,
-                          const std::string& title) {
+                          const std::string& title, const std::vector<PlotLink>& links,
+                          const std::string& links_label) {
   std::ofstream out(path);
   if (!out) throw Error(fmt::format("{}: cannot write the trajectory plot", path.string()));
-  out << trajectory_svg(series, title);
+  out << trajectory_svg(series, title, links, links_label);
   if (!out) throw Error(fmt::format("{}: writing the trajectory plot failed", path.string()));
 }
 

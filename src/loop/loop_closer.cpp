@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <numbers>
 #include <shared_mutex>
@@ -31,6 +32,10 @@ void LoopClosingOptions::validate() const {
   require(consistency_tolerance_deg > 0.0, "loop_closing.consistency_tolerance_deg", "> 0 deg");
   require(min_correction_m >= 0.0, "loop_closing.min_correction_m", ">= 0 m");
   require(min_correction_deg >= 0.0, "loop_closing.min_correction_deg", ">= 0 deg");
+  require(max_drift_percent > 0.0, "loop_closing.max_drift_percent", "> 0 % of the distance driven");
+  require(max_drift_deg_per_100m > 0.0, "loop_closing.max_drift_deg_per_100m", "> 0 deg per 100 m");
+  require(drift_allowance_m >= 0.0, "loop_closing.drift_allowance_m", ">= 0 m");
+  require(drift_allowance_deg >= 0.0, "loop_closing.drift_allowance_deg", ">= 0 deg");
   verification.validate();
   correction.validate();
   require(fusion_neighbours >= 0, "loop_closing.fusion_neighbours", ">= 0 keyframes");
@@ -82,6 +87,12 @@ struct PoseChange {
 PoseChange pose_change(const Eigen::Isometry3d& T_cam_world_a, const Eigen::Isometry3d& T_cam_world_b) {
   return {(T_cam_world_b.inverse().translation() - T_cam_world_a.inverse().translation()).norm(),
           rotation_angle(T_cam_world_b.linear() * T_cam_world_a.linear().transpose()) * 180.0 / std::numbers::pi};
+}
+
+// Whether odometry can have drifted by `asked` over driven_m metres (LoopClosingOptions::max_drift_percent).
+bool plausible_drift(const LoopClosingOptions& o, PoseChange asked, double driven_m) {
+  return asked.m <= o.drift_allowance_m + 0.01 * o.max_drift_percent * driven_m &&
+         asked.deg <= o.drift_allowance_deg + 0.01 * o.max_drift_deg_per_100m * driven_m;
 }
 
 // The loop must hold for the keyframes before `current` too (ORB-SLAM3 checks covisible keyframes
@@ -179,6 +190,7 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
     return done();
   }
   ScanContext context = make_scan_context(scan, options_.scan_context);
+  ++stats_.keyframes;
 
   std::optional<Verified> best;
   std::vector<LoopConstraint> confirmed;  // the earlier keyframes' verifications of the same loop
@@ -186,6 +198,15 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
     std::shared_lock lock(map.mutex());
     const Keyframe* current = map.keyframe(keyframe);
     if (current == nullptr) return done();
+    // odometry: the distance driven up to this keyframe
+    const Eigen::Vector3d centre = current->T_cam_world.inverse().translation();
+    if (last_centre_) driven_total_m_ += (centre - *last_centre_).norm();
+    const double driven = driven_total_m_;
+    if (std::cmp_greater_equal(keyframe.value, driven_m_.size())) {
+      driven_m_.resize(static_cast<std::size_t>(keyframe.value) + 1, std::numeric_limits<double>::quiet_NaN());
+    }
+    driven_m_[static_cast<std::size_t>(keyframe.value)] = driven;
+    last_centre_ = centre;
     Roots roots(map);
     const KeyframeId root = roots(keyframe);
     const auto allowed = [&](std::size_t id) {
@@ -205,6 +226,15 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
                       counts.guided_matches, counts.inliers, verified ? ": verified" : "");
       if (!verified) continue;
       ++step.verified;
+      const PoseChange asked = pose_change(current->T_cam_world, verified->T_cam_world);
+      const double driven_since = driven - driven_m_[place.id];
+      if (!plausible_drift(options_, asked, driven_since)) {
+        logger()->debug("loop: keyframe {} vs {} refused: it would move the map {:.2f} m, {:.2f} deg after {:.1f} m "
+                        "driven",
+                        keyframe.value, candidate.value, asked.m, asked.deg, driven_since);
+        ++step.implausible;
+        continue;
+      }
       if (!best || verified->counts.inliers > best->verification.counts.inliers) {
         best = Verified{std::move(*verified), place.match.distance};
       }
@@ -225,7 +255,11 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
   }
   places_.add(static_cast<std::size_t>(keyframe.value), std::move(context));
   remember(keyframe);
+  stats_.candidates += step.candidates;
+  stats_.verified += step.verified;
+  stats_.implausible += step.implausible;
   if (!step.consistent) return done();
+  ++stats_.consistent;
 
   std::unique_lock lock(map.mutex());
   const Eigen::Isometry3d T_cam_world_before = *map.keyframe_pose(keyframe);
@@ -234,8 +268,10 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
   if (disagreement.m <= options_.min_correction_m && disagreement.deg <= options_.min_correction_deg) {
     logger()->debug("loop: keyframe {} confirms keyframe {} ({:.3f} m, {:.2f} deg off): no correction", keyframe.value,
                     best->verification.constraint.matched.value, disagreement.m, disagreement.deg);
+    ++stats_.confirming;
     return done();
   }
+  ++stats_.closures;
   loops_.push_back(best->verification.constraint);
   loops_.insert(loops_.end(), confirmed.begin(), confirmed.end());
   // Culling may have erased keyframes of earlier loops; their edges go with them.
@@ -254,6 +290,7 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
   if (options_.fuse) closure.fused_landmarks = fuse_across(map, camera_, options_, keyframe, closure.matched);
   if (options_.global_ba) adjust_map(map, keyframe, closure);
   const PoseChange moved = pose_change(T_cam_world_before, *map.keyframe_pose(keyframe));
+  last_centre_ = map.keyframe_pose(keyframe)->inverse().translation();  // odometry goes on from the corrected map
   closure.correction_m = moved.m;
   closure.correction_deg = moved.deg;
   closure.time_ms = watch.elapsed_ms();

@@ -268,4 +268,6 @@ const Map& System::map() const { return impl_->map; }
 const CameraCalibration& System::calibration() const { return impl_->calibration; }
 bool System::loop_closing() const { return impl_->options.loop_closing.enabled; }
 
+LoopClosingStats System::loop_statistics() const { return impl_->closer.stats(); }
+
 }  // namespace rgbl

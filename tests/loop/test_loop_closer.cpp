@@ -156,6 +156,15 @@ TEST_CASE("loop closing options are checked, naming the field") {
   o = {};
   o.global_ba_options.iterations = 0;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("bundle_adjustment.iterations"));
+  o = {};
+  o.max_drift_percent = 0.0;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_closing.max_drift_percent"));
+  o = {};
+  o.max_drift_deg_per_100m = -1.0;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_closing.max_drift_deg_per_100m"));
+  o = {};
+  o.drift_allowance_m = -0.1;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_closing.drift_allowance_m"));
   rgbl::SystemOptions s;
   s.loop_closing.min_correction_m = -1.0;
   CHECK_THROWS_WITH(s.validate(), Catch::Contains("loop_closing.min_correction_m"));

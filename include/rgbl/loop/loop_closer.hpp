@@ -22,6 +22,8 @@
 #include "rgbl/map/map.hpp"
 #include "rgbl/place/scan_context.hpp"
 
+#include <Eigen/Core>
+
 #include <cstddef>
 #include <optional>
 #include <vector>
@@ -50,6 +52,18 @@ struct LoopClosingOptions {
   // confirming the map.
   double min_correction_m = 0.1;
   double min_correction_deg = 0.5;
+  // Odometry drifts, it does not jump: a verified loop is refused when it would move the current
+  // keyframe further than odometry can have drifted over the distance driven since the matched
+  // keyframe (along the keyframes as they were placed), i.e. more than drift_allowance_m +
+  // max_drift_percent % of it, or turn it more than drift_allowance_deg + max_drift_deg_per_100m per
+  // 100 m. A look-alike place (a street of identical blocks) verifies as well as a true one, but asks
+  // for a correction as long as the way back to it. The bounds are several times the worst drift
+  // rgbl shows on any excerpt or scenario (docs/loop-closing.md); a true loop after more drift than
+  // that is refused too, the safe side: a false closure wrecks the map.
+  double max_drift_percent = 10.0;
+  double max_drift_deg_per_100m = 10.0;
+  double drift_allowance_m = 1.0;
+  double drift_allowance_deg = 2.0;
   LoopVerificationOptions verification;
   LoopCorrectionOptions correction;
   // Fusion across the loop: the landmarks of the matched keyframe and its fusion_neighbours best
@@ -86,9 +100,21 @@ struct LoopClosure {
 struct LoopCloserStep {
   int candidates = 0;      // places below max_place_distance that were verified
   int verified = 0;        // of those, verified geometrically
+  int implausible = 0;     // of those, refused: more correction than odometry can have drifted
   bool consistent = false; // a loop verified by consistent_keyframes consecutive keyframes that agree
   double time_ms = 0.0;
   std::optional<LoopClosure> closure;
+};
+
+// The loop closer's counts over a run (what it considered, not only what it closed).
+struct LoopClosingStats {
+  int keyframes = 0;    // processed with a scan
+  int candidates = 0;   // places verified
+  int verified = 0;     // verified geometrically
+  int implausible = 0;  // verified, but refused: more correction than odometry can have drifted
+  int consistent = 0;   // keyframes whose best loop held over consistent_keyframes keyframes
+  int confirming = 0;   // of those, loops that agreed with the map (no correction)
+  int closures = 0;     // of those, loops the map was corrected with
 };
 
 class LoopCloser {
@@ -103,12 +129,19 @@ class LoopCloser {
   // Every loop the map has been corrected with (kept: later corrections must respect earlier loops).
   const std::vector<LoopConstraint>& loops() const { return loops_; }
   const LoopClosingOptions& options() const { return options_; }
+  const LoopClosingStats& stats() const { return stats_; }
 
  private:
   PinholeCamera camera_;
   LoopClosingOptions options_;
   ScanContextDatabase places_;
   std::vector<LoopConstraint> loops_;
+  LoopClosingStats stats_;
+  // Distance driven up to each processed keyframe (by id; NaN: not processed), along the keyframes as
+  // they were placed, and where the last one was.
+  std::vector<double> driven_m_;
+  double driven_total_m_ = 0.0;
+  std::optional<Eigen::Vector3d> last_centre_;
   // The latest consistent_keyframes keyframes processed, oldest first (one spare for a culled one).
   std::vector<KeyframeId> recent_;
   void remember(KeyframeId keyframe);

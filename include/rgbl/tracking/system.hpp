@@ -100,6 +100,8 @@ class System {
   const CameraCalibration& calibration() const;
   // Loops are closed: enabled in the options and mapping inline.
   bool loop_closing() const;
+  // What the loop closer considered so far (all zero without loop closing).
+  LoopClosingStats loop_statistics() const;
 
  struct Impl;  // public name only so that helpers in the .cpp can take it
 
