@@ -95,6 +95,15 @@ void apply_settings(const Settings& s, Pipeline& p) {
     }
   }
   if (s.depth_map_factor) p.depth_settings.rgbd.scale = *s.depth_map_factor;
+  LoopClosingOptions& loop = p.system.loop_closing;
+  const LoopClosingSettings& l = s.loop_closing;
+  if (l.enabled) loop.enabled = *l.enabled;
+  if (l.max_place_distance) loop.max_place_distance = *l.max_place_distance;
+  if (l.consistent_keyframes) loop.consistent_keyframes = *l.consistent_keyframes;
+  if (l.max_drift_percent) loop.max_drift_percent = *l.max_drift_percent;
+  if (l.max_drift_deg_per_100m) loop.max_drift_deg_per_100m = *l.max_drift_deg_per_100m;
+  if (l.fuse) loop.fuse = *l.fuse;
+  if (l.global_ba) loop.global_ba = *l.global_ba;
   if (s.bf || s.th_depth) {
     p.notes.push_back("Camera.bf / ThDepth are not used: rgbl weights depth with an explicit noise model");
   }

@@ -110,6 +110,15 @@ void OrbSettings::validate() const {
           "a fraction in (0, 1]");
 }
 
+void LoopClosingSettings::validate() const {
+  require(!max_place_distance || (*max_place_distance > 0.0 && *max_place_distance <= 1.0),
+          "LoopClosing.MaxPlaceDistance", "a Scan Context distance in (0, 1]");
+  require(!consistent_keyframes || *consistent_keyframes >= 1, "LoopClosing.ConsistentKeyframes", "a count >= 1");
+  require(!max_drift_percent || *max_drift_percent > 0.0, "LoopClosing.MaxDriftPercent", "a percentage > 0");
+  require(!max_drift_deg_per_100m || *max_drift_deg_per_100m > 0.0, "LoopClosing.MaxDriftDegPer100m",
+          "degrees per 100 m > 0");
+}
+
 Settings read_settings(const std::filesystem::path& yaml) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(yaml, ec)) {
@@ -268,11 +277,26 @@ Settings read_settings(const std::filesystem::path& yaml) {
     s.kernel_size = *v;
   }
 
+  const auto flag = [&](std::string_view key) -> std::optional<bool> {
+    const auto v = r.integer({key});
+    if (!v) return std::nullopt;
+    if (*v != 0 && *v != 1) r.fail(std::string(key), "0 (off) or 1 (on)");
+    return *v == 1;
+  };
+  s.loop_closing.enabled = flag("LoopClosing.Enabled");
+  s.loop_closing.max_place_distance = r.number({"LoopClosing.MaxPlaceDistance"});
+  s.loop_closing.consistent_keyframes = r.integer({"LoopClosing.ConsistentKeyframes"});
+  s.loop_closing.max_drift_percent = r.number({"LoopClosing.MaxDriftPercent"});
+  s.loop_closing.max_drift_deg_per_100m = r.number({"LoopClosing.MaxDriftDegPer100m"});
+  s.loop_closing.fuse = flag("LoopClosing.Fuse");
+  s.loop_closing.global_ba = flag("LoopClosing.GlobalBA");
+
   if (!(s.projection.min_depth >= 0.0F)) r.fail("LiDAR.min_dist", "a distance >= 0 m");
   if (!(s.projection.max_depth > s.projection.min_depth))
     r.fail("LiDAR.max_dist", "a distance greater than LiDAR.min_dist");
   try {
     s.orb.validate();
+    s.loop_closing.validate();
   } catch (const ConfigError& e) {
     throw ParseError(yaml, 0, fmt::format("key '{}': {}", e.key(), e.what()));
   }

@@ -131,7 +131,35 @@ TEST_CASE("settings: a minimal file gives the defaults", "[io][settings]") {
   CHECK(s.orb.n_levels == orb.num_levels);
   CHECK(s.projection.min_depth == 5.0F);
   CHECK(s.kernel_size == 0);
+  CHECK_FALSE(s.loop_closing.enabled);
+  CHECK_FALSE(s.loop_closing.max_drift_percent);
   CHECK(s.warnings.empty());
+}
+
+TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
+  rgbl::test::TempDir tmp;
+  const auto s = rgbl::read_settings(
+      tmp.write("loop.yaml", "%YAML:1.0\nLoopClosing.Enabled: 0\nLoopClosing.MaxPlaceDistance: 0.3\n"
+                             "LoopClosing.ConsistentKeyframes: 4\nLoopClosing.MaxDriftPercent: 5\n"
+                             "LoopClosing.MaxDriftDegPer100m: 4.5\nLoopClosing.Fuse: 1\nLoopClosing.GlobalBA: 0\n"));
+  CHECK(s.loop_closing.enabled == false);
+  CHECK(s.loop_closing.max_place_distance == 0.3);
+  CHECK(s.loop_closing.consistent_keyframes == 4);
+  CHECK(s.loop_closing.max_drift_percent == 5.0);
+  CHECK(s.loop_closing.max_drift_deg_per_100m == 4.5);
+  CHECK(s.loop_closing.fuse == true);
+  CHECK(s.loop_closing.global_ba == false);
+  CHECK(s.warnings.empty());
+  CHECK_THAT(error_of(tmp.write("l1.yaml", "%YAML:1.0\nLoopClosing.Enabled: 2\n")),
+             Contains("'LoopClosing.Enabled': expected 0 (off) or 1 (on)"));
+  CHECK_THAT(error_of(tmp.write("l2.yaml", "%YAML:1.0\nLoopClosing.MaxPlaceDistance: 1.5\n")),
+             Contains("'LoopClosing.MaxPlaceDistance': expected a Scan Context distance in (0, 1]"));
+  CHECK_THAT(error_of(tmp.write("l3.yaml", "%YAML:1.0\nLoopClosing.ConsistentKeyframes: 0\n")),
+             Contains("'LoopClosing.ConsistentKeyframes': expected a count >= 1"));
+  CHECK_THAT(error_of(tmp.write("l4.yaml", "%YAML:1.0\nLoopClosing.MaxDriftPercent: -1\n")),
+             Contains("'LoopClosing.MaxDriftPercent': expected a percentage > 0"));
+  CHECK_THAT(error_of(tmp.write("l5.yaml", "%YAML:1.0\nLoopClosing.GlobalBA: yes\n")),
+             Contains("LoopClosing.GlobalBA"));
 }
 
 TEST_CASE("settings: wrong types, incomplete groups and bad values name file and key", "[io][settings][bad-input]") {

@@ -8,7 +8,9 @@
 //   ThDepth, DepthMapFactor,
 //   ORBextractor.nFeatures scaleFactor nLevels iniThFAST minThFAST,
 //   LiDAR.Method, LiDAR.min_dist, LiDAR.max_dist, LiDAR.Tr11 .. LiDAR.Tr34 (T_cam_lidar, row-major),
-//   LiDAR.MethodInverseDilation.KernelType, LiDAR.MethodInverseDilation.KernelSize_u.
+//   LiDAR.MethodInverseDilation.KernelType, LiDAR.MethodInverseDilation.KernelSize_u,
+//   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
+//   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1) (LoopClosingOptions' fields of those names).
 // Viewer.* and other display-only ORB-SLAM keys are accepted and ignored without a warning.
 
 #include "rgbl/geometry/camera.hpp"
@@ -37,6 +39,19 @@ struct OrbSettings {
   void validate() const;
 };
 
+// rgbl's LoopClosing.* keys; unset = LoopClosingOptions' default.
+struct LoopClosingSettings {
+  std::optional<bool> enabled;
+  std::optional<double> max_place_distance;
+  std::optional<int> consistent_keyframes;
+  std::optional<double> max_drift_percent;
+  std::optional<double> max_drift_deg_per_100m;
+  std::optional<bool> fuse;
+  std::optional<bool> global_ba;
+
+  void validate() const;  // ConfigError naming the LoopClosing.* key
+};
+
 struct Settings {
   std::filesystem::path file;
   std::optional<PinholeCamera> camera;  // width/height 0 when the file does not give them
@@ -51,6 +66,7 @@ struct Settings {
   std::optional<Eigen::Isometry3d> T_cam_lidar;
   std::string kernel_type;            // e.g. "Diamond"; empty when absent
   int kernel_size = 0;                // 0 when absent
+  LoopClosingSettings loop_closing;
   std::vector<std::string> warnings;  // unknown keys, one message each
 };
 
