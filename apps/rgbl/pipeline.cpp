@@ -104,6 +104,7 @@ void apply_settings(const Settings& s, Pipeline& p) {
   if (l.max_drift_deg_per_100m) loop.max_drift_deg_per_100m = *l.max_drift_deg_per_100m;
   if (l.fuse) loop.fuse = *l.fuse;
   if (l.global_ba) loop.global_ba = *l.global_ba;
+  if (l.merge_maps) loop.merge_maps = *l.merge_maps;
   if (s.bf || s.th_depth) {
     p.notes.push_back("Camera.bf / ThDepth are not used: rgbl weights depth with an explicit noise model");
   }

@@ -308,11 +308,12 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
     const LoopClosure& c = *r.result.loop_closure;
     closures.push_back(&c);
     loop_closures += fmt::format(
-        "{}\n    {{\"frame\": {}, \"matched_frame\": {}, \"place_distance\": {}, \"inliers\": {}, "
+        "{}\n    {{\"frame\": {}, \"matched_frame\": {}, \"merge\": {}, \"place_distance\": {}, \"inliers\": {}, "
         "\"correction_m\": {}, \"correction_deg\": {}, \"loop_error_before_m\": {}, \"loop_error_after_m\": {}, "
         "\"fused_landmarks\": {}, \"global_ba\": {{\"keyframes\": {}, \"landmarks\": {}, \"outliers\": {}, "
         "\"time_ms\": {}}}, \"time_ms\": {}}}",
-        loop_closures.empty() ? "" : ",", c.frame_index, c.matched_frame_index, json_number(c.place_distance), c.inliers,
+        loop_closures.empty() ? "" : ",", c.frame_index, c.matched_frame_index, c.merged ? "true" : "false",
+        json_number(c.place_distance), c.inliers,
         json_number(c.correction_m), json_number(c.correction_deg), json_number(c.correction.loop_error_before_m),
         json_number(c.correction.loop_error_after_m), c.fused_landmarks, c.global_ba_keyframes, c.global_ba_landmarks,
         c.global_ba_outliers, json_number(c.global_ba_ms), json_number(c.time_ms));
@@ -338,9 +339,10 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
          << fmt::format("  \"loop_closing\": {},\n  \"loop_closures\": [{}],\n",
                         system.loop_closing() ? "true" : "false", loop_closures)
          << fmt::format("  \"loop_candidates\": {{\"keyframes\": {}, \"candidates\": {}, \"verified\": {}, "
-                        "\"implausible\": {}, \"consistent\": {}, \"confirming\": {}, \"closures\": {}}},\n",
+                        "\"implausible\": {}, \"consistent\": {}, \"confirming\": {}, \"closures\": {}, "
+                        "\"merges\": {}}},\n",
                         loop_stats.keyframes, loop_stats.candidates, loop_stats.verified, loop_stats.implausible,
-                        loop_stats.consistent, loop_stats.confirming, loop_stats.closures)
+                        loop_stats.consistent, loop_stats.confirming, loop_stats.closures, loop_stats.merges)
          << fmt::format("  \"threaded_mapping\": {},\n  \"wall_s\": {},\n", threaded ? "true" : "false",
                         json_number(out.wall_s))
          << "  \"stage_ms\": {\n    " << stage_json("io_wait", stats(io_ms)) << ",\n    "
@@ -364,9 +366,10 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
                loop_stats.implausible);
   }
   for (const LoopClosure* c : closures) {
-    fmt::print("  loop closed at frame {} with frame {}: map moved {:.2f} m / {:.2f} deg there, {} landmarks fused, "
+    fmt::print("  {} at frame {} with frame {}: map moved {:.2f} m / {:.2f} deg there, {} landmarks fused, "
                "{:.0f} ms (global BA of {} keyframes {:.0f} ms)\n",
-               c->frame_index, c->matched_frame_index, c->correction_m, c->correction_deg, c->fused_landmarks,
+               c->merged ? "maps merged" : "loop closed", c->frame_index, c->matched_frame_index, c->correction_m,
+               c->correction_deg, c->fused_landmarks,
                c->time_ms, c->global_ba_keyframes, c->global_ba_ms);
   }
   fmt::print("  per frame (median / p95 ms): depth {:.2f} / {:.2f}, extraction {:.2f} / {:.2f}, tracking {:.2f} / "

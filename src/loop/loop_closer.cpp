@@ -46,7 +46,7 @@ void LoopClosingOptions::validate() const {
 namespace {
 
 // Spanning-tree roots, memoised for one query: keyframes of one map share the root, a map started
-// after a loss has its own (a loop across two maps is a merge, which needs more than a pose graph).
+// after a loss has its own until a loop across the two merges them.
 // Each keyframe is walked once per query, however many candidates ask.
 class Roots {
  public:
@@ -151,6 +151,28 @@ int fuse_across(Map& map, const PinholeCamera& camera, const LoopClosingOptions&
   return fused;
 }
 
+// Moves every keyframe and landmark of the map rooted at `root` by T_old_new (a point x of that map is
+// at T_old_new * x in the matched map) and hangs its root from `matched`.
+void merge_maps(Map& map, KeyframeId root, KeyframeId matched, const Eigen::Isometry3d& T_old_new) {
+  Roots roots(map);
+  std::vector<KeyframeId> moved;
+  for (const KeyframeId k : map.keyframe_ids()) {
+    if (roots(k) == root) moved.push_back(k);
+  }
+  const std::vector<LandmarkId> landmarks = map.landmarks_seen_by(moved);  // only its own: the maps share none
+  const Eigen::Isometry3d T_new_old = T_old_new.inverse();
+  for (const KeyframeId k : moved) {
+    Keyframe& kf = *map.keyframe(k);
+    kf.T_cam_world = kf.T_cam_world * T_new_old;
+  }
+  for (const LandmarkId l : landmarks) {
+    Landmark& lm = *map.landmark(l);
+    lm.position = T_old_new * lm.position;
+  }
+  for (const LandmarkId l : landmarks) map.update_landmark(l);
+  map.keyframe(root)->parent = matched;
+}
+
 }  // namespace
 
 LoopCloser::LoopCloser(const PinholeCamera& camera, LoopClosingOptions options)
@@ -194,6 +216,8 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
 
   std::optional<Verified> best;
   std::vector<LoopConstraint> confirmed;  // the earlier keyframes' verifications of the same loop
+  KeyframeId current_root;
+  bool merge = false;  // the loop joins another map
   {
     std::shared_lock lock(map.mutex());
     const Keyframe* current = map.keyframe(keyframe);
@@ -212,22 +236,28 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
     const auto allowed = [&](std::size_t id) {
       const KeyframeId candidate{static_cast<int>(id)};
       return candidate.value <= keyframe.value - options_.min_keyframe_gap && map.keyframe(candidate) != nullptr &&
-             !current->covisibility.contains(candidate) && roots(candidate) == root;
+             !current->covisibility.contains(candidate) && (options_.merge_maps || roots(candidate) == root);
     };
+    // Places of every map: one of another map (started after a loss) is a merge candidate.
+    std::vector<std::pair<KeyframeId, double>> candidates;  // with their place distance
     for (const auto& place : places_.query(context, options_.ring_key_neighbours, allowed)) {
       if (place.match.distance > options_.max_place_distance) break;  // sorted, best first
-      if (std::cmp_greater_equal(step.candidates, options_.max_candidates)) break;
+      if (std::cmp_greater_equal(candidates.size(), options_.max_candidates)) break;
+      candidates.emplace_back(KeyframeId{static_cast<int>(place.id)}, place.match.distance);
+    }
+    for (const auto& [candidate, place_distance] : candidates) {
       ++step.candidates;
-      const KeyframeId candidate{static_cast<int>(place.id)};
       LoopVerificationCounts counts;
       auto verified = verify_loop(camera_, *current, map, candidate, options_.verification, &counts);
-      logger()->debug("loop: keyframe {} vs {} (place {:.3f}): {} matches, {} RANSAC inliers, {} guided, {} inliers{}",
-                      keyframe.value, candidate.value, place.match.distance, counts.matches, counts.ransac_inliers,
-                      counts.guided_matches, counts.inliers, verified ? ": verified" : "");
+      logger()->debug("loop: keyframe {} vs {}{} (place {:.3f}): {} matches, {} RANSAC inliers, {} guided, {} "
+                      "inliers{}",
+                      keyframe.value, candidate.value, roots(candidate) == root ? "" : " of another map", place_distance,
+                      counts.matches, counts.ransac_inliers, counts.guided_matches, counts.inliers,
+                      verified ? ": verified" : "");
       if (!verified) continue;
       ++step.verified;
       const PoseChange asked = pose_change(current->T_cam_world, verified->T_cam_world);
-      const double driven_since = driven - driven_m_[place.id];
+      const double driven_since = driven - driven_m_[static_cast<std::size_t>(candidate.value)];
       if (!plausible_drift(options_, asked, driven_since)) {
         logger()->debug("loop: keyframe {} vs {} refused: it would move the map {:.2f} m, {:.2f} deg after {:.1f} m "
                         "driven",
@@ -236,14 +266,14 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
         continue;
       }
       if (!best || verified->counts.inliers > best->verification.counts.inliers) {
-        best = Verified{std::move(*verified), place.match.distance};
+        best = Verified{std::move(*verified), place_distance};
       }
     }
     if (best) {
       std::vector<KeyframeId> previous;  // the newest live ones, newest first
       for (auto it = recent_.rbegin();
            it != recent_.rend() && std::cmp_less(previous.size() + 1, options_.consistent_keyframes); ++it) {
-        if (map.keyframe(*it) != nullptr) previous.push_back(*it);
+        if (map.keyframe(*it) != nullptr && roots(*it) == root) previous.push_back(*it);
       }
       if (std::cmp_equal(previous.size() + 1, options_.consistent_keyframes)) {
         if (auto constraints = confirm(camera_, options_, map, *current, *best, previous)) {
@@ -251,7 +281,9 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
           confirmed = std::move(*constraints);
         }
       }
+      merge = roots(best->verification.constraint.matched) != root;
     }
+    current_root = root;
   }
   places_.add(static_cast<std::size_t>(keyframe.value), std::move(context));
   remember(keyframe);
@@ -265,7 +297,7 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
   const Eigen::Isometry3d T_cam_world_before = *map.keyframe_pose(keyframe);
   // How far the map is from the loop's measurement at the current keyframe.
   const PoseChange disagreement = pose_change(T_cam_world_before, best->verification.T_cam_world);
-  if (disagreement.m <= options_.min_correction_m && disagreement.deg <= options_.min_correction_deg) {
+  if (!merge && disagreement.m <= options_.min_correction_m && disagreement.deg <= options_.min_correction_deg) {
     logger()->debug("loop: keyframe {} confirms keyframe {} ({:.3f} m, {:.2f} deg off): no correction", keyframe.value,
                     best->verification.constraint.matched.value, disagreement.m, disagreement.deg);
     ++stats_.confirming;
@@ -286,6 +318,15 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
   closure.matched_frame_index = map.keyframe(closure.matched)->frame_index;
   closure.place_distance = best->place_distance;
   closure.inliers = best->verification.counts.inliers;
+  if (merge) {
+    // The current map moves rigidly onto the matched one (metric depth: no scale), and its root hangs
+    // from the matched keyframe: one spanning tree, which the pose graph and bundle adjustment below
+    // then treat as one map.
+    const Eigen::Isometry3d T_old_new = best->verification.T_cam_world.inverse() * T_cam_world_before;
+    merge_maps(map, current_root, closure.matched, T_old_new);
+    closure.merged = true;
+    ++stats_.merges;
+  }
   closure.correction = correct_loops(map, loops_, options_.correction);
   if (options_.fuse) closure.fused_landmarks = fuse_across(map, camera_, options_, keyframe, closure.matched);
   if (options_.global_ba) adjust_map(map, keyframe, closure);
@@ -294,10 +335,10 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
   closure.correction_m = moved.m;
   closure.correction_deg = moved.deg;
   closure.time_ms = watch.elapsed_ms();
-  logger()->info("loop closed: frame {} with frame {} (place {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
+  logger()->info("{}: frame {} with frame {} (place {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
                  "loop error {:.2f} -> {:.3f} m, {} landmarks fused, global BA {} keyframes {:.0f} ms, {:.0f} ms",
-                 closure.frame_index, closure.matched_frame_index, closure.place_distance, closure.inliers,
-                 closure.correction_m, closure.correction_deg, closure.correction.loop_error_before_m,
+                 closure.merged ? "maps merged" : "loop closed", closure.frame_index, closure.matched_frame_index,
+                 closure.place_distance, closure.inliers, closure.correction_m, closure.correction_deg, closure.correction.loop_error_before_m,
                  closure.correction.loop_error_after_m, closure.fused_landmarks, closure.global_ba_keyframes,
                  closure.global_ba_ms, closure.time_ms);
   step.closure = closure;

@@ -164,7 +164,9 @@ int LocalMapper::cull_keyframes(KeyframeId id) {
   for (const KeyframeId k : map_.best_covisible(id, 100)) {
     if (k.value == 0 || k == id) continue;
     const Keyframe* kf = map_.keyframe(k);
-    if (kf == nullptr) continue;
+    // a map's root stays: frames of a map started after a loss hang from it, and move with it when
+    // that map is merged into another
+    if (kf == nullptr || !kf->parent.valid()) continue;
     int total = 0, redundant = 0;
     for (std::size_t i = 0; i < kf->landmarks.size(); ++i) {
       const Landmark* l = kf->landmarks[i].valid() ? map_.landmark(kf->landmarks[i]) : nullptr;

@@ -10,7 +10,8 @@
 //   LiDAR.Method, LiDAR.min_dist, LiDAR.max_dist, LiDAR.Tr11 .. LiDAR.Tr34 (T_cam_lidar, row-major),
 //   LiDAR.MethodInverseDilation.KernelType, LiDAR.MethodInverseDilation.KernelSize_u,
 //   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
-//   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1) (LoopClosingOptions' fields of those names).
+//   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1), MergeMaps (0/1) (LoopClosingOptions' fields of those
+//   names).
 // Viewer.* and other display-only ORB-SLAM keys are accepted and ignored without a warning.
 
 #include "rgbl/geometry/camera.hpp"
@@ -48,6 +49,7 @@ struct LoopClosingSettings {
   std::optional<double> max_drift_deg_per_100m;
   std::optional<bool> fuse;
   std::optional<bool> global_ba;
+  std::optional<bool> merge_maps;
 
   void validate() const;  // ConfigError naming the LoopClosing.* key
 };

@@ -10,8 +10,11 @@
 // the whole map (of the closing keyframe's spanning tree) then refines every keyframe and landmark
 // against all observations, old lap and new.
 //
-// Not here yet (issue 14): a bag of words for depth sources without a scan, map merging, a thread of
-// its own.
+// A loop whose matched place lies in another map (one started after a loss) merges the two: the
+// current map moves rigidly onto the other, its root hangs from the matched keyframe, and the same
+// correction follows.
+//
+// Not here yet (issue 14): a bag of words for depth sources without a scan, a thread of its own.
 
 #include "rgbl/backend/bundle_adjustment.hpp"
 #include "rgbl/backend/loop_correction.hpp"
@@ -64,6 +67,10 @@ struct LoopClosingOptions {
   double max_drift_deg_per_100m = 10.0;
   double drift_allowance_m = 1.0;
   double drift_allowance_deg = 2.0;
+  // Map merging: a loop verified against a place of another map (one started after a loss, or the map
+  // such a map was started from) moves the current map onto it rigidly (metric depth: no scale) and
+  // joins the two; the same checks as a loop decide.
+  bool merge_maps = true;
   LoopVerificationOptions verification;
   LoopCorrectionOptions correction;
   // Fusion across the loop: the landmarks of the matched keyframe and its fusion_neighbours best
@@ -83,6 +90,7 @@ struct LoopClosure {
   std::size_t frame_index = 0;          // of the keyframe that closed it
   std::size_t matched_frame_index = 0;  // of the older keyframe it matched
   KeyframeId current, matched;
+  bool merged = false;                  // the loop joined two maps (matched lies in the older one)
   double place_distance = 0.0;          // Scan Context distance of the match
   int inliers = 0;                      // of the verification
   double correction_m = 0.0;            // how far the current keyframe moved
@@ -115,6 +123,7 @@ struct LoopClosingStats {
   int consistent = 0;   // keyframes whose best loop held over consistent_keyframes keyframes
   int confirming = 0;   // of those, loops that agreed with the map (no correction)
   int closures = 0;     // of those, loops the map was corrected with
+  int merges = 0;       // of those, closures that joined two maps
 };
 
 class LoopCloser {
