@@ -194,6 +194,15 @@ void LoopCloser::adjust_map(Map& map, KeyframeId keyframe, LoopClosure& closure)
   closure.global_ba_ms = watch.elapsed_ms();
 }
 
+double LoopCloser::record_odometry(KeyframeId keyframe, const Eigen::Vector3d& centre) {
+  if (last_centre_) driven_total_m_ += (centre - *last_centre_).norm();
+  last_centre_ = centre;
+  const auto slot = static_cast<std::size_t>(keyframe.value);
+  if (slot >= driven_m_.size()) driven_m_.resize(slot + 1, std::numeric_limits<double>::quiet_NaN());
+  driven_m_[slot] = driven_total_m_;
+  return driven_total_m_;
+}
+
 void LoopCloser::remember(KeyframeId keyframe) {
   recent_.push_back(keyframe);
   if (std::cmp_greater(recent_.size(), options_.consistent_keyframes)) recent_.erase(recent_.begin());
@@ -222,17 +231,10 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
     std::shared_lock lock(map.mutex());
     const Keyframe* current = map.keyframe(keyframe);
     if (current == nullptr) return done();
-    // odometry: the distance driven up to this keyframe
-    const Eigen::Vector3d centre = current->T_cam_world.inverse().translation();
-    if (last_centre_) driven_total_m_ += (centre - *last_centre_).norm();
-    const double driven = driven_total_m_;
-    if (std::cmp_greater_equal(keyframe.value, driven_m_.size())) {
-      driven_m_.resize(static_cast<std::size_t>(keyframe.value) + 1, std::numeric_limits<double>::quiet_NaN());
-    }
-    driven_m_[static_cast<std::size_t>(keyframe.value)] = driven;
-    last_centre_ = centre;
+    const double driven = record_odometry(keyframe, current->center());
     Roots roots(map);
-    const KeyframeId root = roots(keyframe);
+    current_root = roots(keyframe);
+    const KeyframeId root = current_root;
     const auto allowed = [&](std::size_t id) {
       const KeyframeId candidate{static_cast<int>(id)};
       return candidate.value <= keyframe.value - options_.min_keyframe_gap && map.keyframe(candidate) != nullptr &&
@@ -283,7 +285,6 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
       }
       merge = roots(best->verification.constraint.matched) != root;
     }
-    current_root = root;
   }
   places_.add(static_cast<std::size_t>(keyframe.value), std::move(context));
   remember(keyframe);
@@ -331,15 +332,15 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
   if (options_.fuse) closure.fused_landmarks = fuse_across(map, camera_, options_, keyframe, closure.matched);
   if (options_.global_ba) adjust_map(map, keyframe, closure);
   const PoseChange moved = pose_change(T_cam_world_before, *map.keyframe_pose(keyframe));
-  last_centre_ = map.keyframe_pose(keyframe)->inverse().translation();  // odometry goes on from the corrected map
+  last_centre_ = map.keyframe(keyframe)->center();  // odometry goes on from the corrected map
   closure.correction_m = moved.m;
   closure.correction_deg = moved.deg;
   closure.time_ms = watch.elapsed_ms();
   logger()->info("{}: frame {} with frame {} (place {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
                  "loop error {:.2f} -> {:.3f} m, {} landmarks fused, global BA {} keyframes {:.0f} ms, {:.0f} ms",
                  closure.merged ? "maps merged" : "loop closed", closure.frame_index, closure.matched_frame_index,
-                 closure.place_distance, closure.inliers, closure.correction_m, closure.correction_deg, closure.correction.loop_error_before_m,
-                 closure.correction.loop_error_after_m, closure.fused_landmarks, closure.global_ba_keyframes,
+                 closure.place_distance, closure.inliers, closure.correction_m, closure.correction_deg,
+                 closure.correction.loop_error_before_m, closure.correction.loop_error_after_m, closure.fused_landmarks, closure.global_ba_keyframes,
                  closure.global_ba_ms, closure.time_ms);
   step.closure = closure;
   return done();

@@ -134,37 +134,24 @@ TEST_CASE("loop closer: a real drive without a loop closes nothing and tracks bi
 }
 
 TEST_CASE("loop closing options are checked, naming the field") {
-  rgbl::LoopClosingOptions o;
-  CHECK_NOTHROW(o.validate());
-  o.max_place_distance = 0.0;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_closing.max_place_distance"));
-  o = {};
-  o.consistent_keyframes = 0;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_closing.consistent_keyframes"));
-  o = {};
-  o.verification.guided_radius_px = 0.0;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_verification.guided_radius_px"));
-  o = {};
-  o.scan_context.sectors = 1;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("scan_context.sectors"));
-  o = {};
-  o.fusion_neighbours = -1;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_closing.fusion_neighbours"));
-  o = {};
-  o.fusion.radius_px = 0.0;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("fusion.radius_px"));
-  o = {};
-  o.global_ba_options.iterations = 0;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("bundle_adjustment.iterations"));
-  o = {};
-  o.max_drift_percent = 0.0;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_closing.max_drift_percent"));
-  o = {};
-  o.max_drift_deg_per_100m = -1.0;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_closing.max_drift_deg_per_100m"));
-  o = {};
-  o.drift_allowance_m = -0.1;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_closing.drift_allowance_m"));
+  CHECK_NOTHROW(rgbl::LoopClosingOptions{}.validate());
+  // each change to the defaults must be refused with the field's key in the message
+  const auto refused = [](void (*change)(rgbl::LoopClosingOptions&), const char* key) {
+    rgbl::LoopClosingOptions o;
+    change(o);
+    CHECK_THROWS_WITH(o.validate(), Catch::Contains(key));
+  };
+  refused([](auto& o) { o.max_place_distance = 0.0; }, "loop_closing.max_place_distance");
+  refused([](auto& o) { o.consistent_keyframes = 0; }, "loop_closing.consistent_keyframes");
+  refused([](auto& o) { o.verification.guided_radius_px = 0.0; }, "loop_verification.guided_radius_px");
+  refused([](auto& o) { o.scan_context.sectors = 1; }, "scan_context.sectors");
+  refused([](auto& o) { o.fusion_neighbours = -1; }, "loop_closing.fusion_neighbours");
+  refused([](auto& o) { o.fusion.radius_px = 0.0; }, "fusion.radius_px");
+  refused([](auto& o) { o.global_ba_options.iterations = 0; }, "bundle_adjustment.iterations");
+  refused([](auto& o) { o.max_drift_percent = 0.0; }, "loop_closing.max_drift_percent");
+  refused([](auto& o) { o.max_drift_deg_per_100m = -1.0; }, "loop_closing.max_drift_deg_per_100m");
+  refused([](auto& o) { o.drift_allowance_m = -0.1; }, "loop_closing.drift_allowance_m");
+  refused([](auto& o) { o.drift_allowance_deg = -0.1; }, "loop_closing.drift_allowance_deg");
   rgbl::SystemOptions s;
   s.loop_closing.min_correction_m = -1.0;
   CHECK_THROWS_WITH(s.validate(), Catch::Contains("loop_closing.min_correction_m"));

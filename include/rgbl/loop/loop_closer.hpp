@@ -151,6 +151,8 @@ class LoopCloser {
   std::vector<double> driven_m_;
   double driven_total_m_ = 0.0;
   std::optional<Eigen::Vector3d> last_centre_;
+  // Adds the way from the last processed keyframe to `centre`; the distance driven up to `keyframe`.
+  double record_odometry(KeyframeId keyframe, const Eigen::Vector3d& centre);
   // The latest consistent_keyframes keyframes processed, oldest first (one spare for a culled one).
   std::vector<KeyframeId> recent_;
   void remember(KeyframeId keyframe);
