@@ -28,6 +28,7 @@ void LoopClosingOptions::validate() const {
   require(max_candidates >= 1, "loop_closing.max_candidates", ">= 1 candidate");
   require(min_keyframe_gap >= 1, "loop_closing.min_keyframe_gap", ">= 1 keyframe");
   require(consistent_keyframes >= 1, "loop_closing.consistent_keyframes", ">= 1 keyframe");
+  require(matched_side_keyframes <= 100, "loop_closing.matched_side_keyframes", "<= 100 keyframes");
   require(consistency_tolerance_m > 0.0, "loop_closing.consistency_tolerance_m", "> 0 m");
   require(consistency_tolerance_deg > 0.0, "loop_closing.consistency_tolerance_deg", "> 0 deg");
   require(min_correction_m >= 0.0, "loop_closing.min_correction_m", ">= 0 m");
@@ -95,18 +96,34 @@ bool plausible_drift(const LoopClosingOptions& o, PoseChange asked, double drive
          asked.deg <= o.drift_allowance_deg + 0.01 * o.max_drift_deg_per_100m * driven_m;
 }
 
-// The loop must hold for the keyframes before `current` too (ORB-SLAM3 checks covisible keyframes
-// already in the map rather than waiting for new ones, which a loop ending where the drive ends never
-// brings): each verifies against the same matched keyframe by a guided search from the pose the loop
-// implies for it, and its measured pose relative to `current` agrees with the map's, which odometry
-// knows to centimetres over a few keyframes. Their loop constraints, or nullopt.
+// The loop must hold for more keyframe pairs than the one that found it (ORB-SLAM3 checks covisible
+// keyframes already in the map rather than waiting for new ones, which a loop ending where the drive
+// ends never brings). First the keyframes before `current`: each verifies against the same matched
+// keyframe by a guided search from the pose the loop implies for it, and its measured pose relative
+// to `current` must agree with the map's, which odometry knows to centimetres over a few keyframes.
+// One that does not see the place is skipped (one that sees it and disagrees refuses the loop); then
+// `current` against the matched keyframe's best covisible ones, each measuring current's pose again
+// from other keyframes' landmarks, within the same tolerances. The loop constraints of the pairs that
+// confirmed (LoopClosingOptions::consistent_keyframes - 1 of them), or nullopt.
 std::optional<std::vector<LoopConstraint>> confirm(const PinholeCamera& camera, const LoopClosingOptions& options,
                                                    const Map& map, const Keyframe& current, const Verified& loop,
                                                    std::span<const KeyframeId> previous) {
   const Eigen::Isometry3d& T_cur_world_loop = loop.verification.T_cam_world;
   const KeyframeId matched = loop.verification.constraint.matched;
+  const auto needed = static_cast<std::size_t>(options.consistent_keyframes - 1);
   std::vector<LoopConstraint> constraints;
+  const auto agrees = [&](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, KeyframeId with,
+                          KeyframeId against) {
+    const PoseChange disagreement = pose_change(a, b);
+    if (disagreement.m <= options.consistency_tolerance_m && disagreement.deg <= options.consistency_tolerance_deg) {
+      return true;
+    }
+    logger()->debug("loop: keyframe {} vs {} disagrees with keyframe {} vs {} by {:.3f} m, {:.2f} deg", with.value,
+                    against.value, current.id.value, matched.value, disagreement.m, disagreement.deg);
+    return false;
+  };
   for (const KeyframeId id : previous) {
+    if (constraints.size() >= needed) break;
     const Keyframe& k = *map.keyframe(id);
     const Eigen::Isometry3d T_k_cur_map = k.T_cam_world * current.T_cam_world.inverse();
     LoopVerificationCounts counts;
@@ -116,17 +133,30 @@ std::optional<std::vector<LoopConstraint>> confirm(const PinholeCamera& camera, 
       logger()->debug("loop: keyframe {} verified keyframe {} but keyframe {} does not ({} matches, {} guided, {} "
                       "inliers)",
                       current.id.value, matched.value, id.value, counts.matches, counts.guided_matches, counts.inliers);
-      return std::nullopt;
+      continue;
     }
     // T_k_cur measured through the loop against the map's: equal when both are right
-    const PoseChange disagreement = pose_change(T_k_cur_map, again->T_cam_world * T_cur_world_loop.inverse());
-    if (disagreement.m > options.consistency_tolerance_m || disagreement.deg > options.consistency_tolerance_deg) {
-      logger()->debug("loop: keyframe {} and {} disagree on the loop by {:.3f} m, {:.2f} deg", current.id.value,
-                      id.value, disagreement.m, disagreement.deg);
-      return std::nullopt;
-    }
+    if (!agrees(T_k_cur_map, again->T_cam_world * T_cur_world_loop.inverse(), id, matched)) return std::nullopt;
     constraints.push_back(again->constraint);
   }
+  if (constraints.size() < needed) {
+    for (const KeyframeId other : map.best_covisible(matched, options.matched_side_keyframes)) {
+      if (constraints.size() >= needed) break;
+      if (current.covisibility.contains(other)) continue;
+      LoopVerificationCounts counts;
+      const auto again = verify_loop_guided(camera, current, map, other, T_cur_world_loop, options.verification, &counts);
+      if (!again) {
+        logger()->debug("loop: keyframe {} verified keyframe {} but not its neighbour {} ({} matches, {} guided, {} "
+                        "inliers)",
+                        current.id.value, matched.value, other.value, counts.matches, counts.guided_matches,
+                        counts.inliers);
+        continue;
+      }
+      if (!agrees(T_cur_world_loop, again->T_cam_world, current.id, other)) return std::nullopt;
+      constraints.push_back(again->constraint);
+    }
+  }
+  if (constraints.size() < needed) return std::nullopt;
   return constraints;
 }
 
@@ -277,11 +307,9 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
            it != recent_.rend() && std::cmp_less(previous.size() + 1, options_.consistent_keyframes); ++it) {
         if (map.keyframe(*it) != nullptr && roots(*it) == root) previous.push_back(*it);
       }
-      if (std::cmp_equal(previous.size() + 1, options_.consistent_keyframes)) {
-        if (auto constraints = confirm(camera_, options_, map, *current, *best, previous)) {
-          step.consistent = true;
-          confirmed = std::move(*constraints);
-        }
+      if (auto constraints = confirm(camera_, options_, map, *current, *best, previous)) {
+        step.consistent = true;
+        confirmed = std::move(*constraints);
       }
       merge = roots(best->verification.constraint.matched) != root;
     }

@@ -45,9 +45,16 @@ struct LoopClosingOptions {
   // Candidates are keyframes at least this many keyframes older than the query and not covisible with
   // it: a recent keyframe is the local map's business, not a loop's.
   int min_keyframe_gap = 10;
-  // Consecutive keyframes (this one and those before it) that must each verify the loop (ORB-SLAM: 3),
-  // and agree on it: their loop-measured poses relative to each other within these of the map's.
+  // Keyframe pairs that must each verify the loop (ORB-SLAM: 3 keyframes) and agree on it: this
+  // keyframe with the matched one, then the keyframes before this one with the matched one, their
+  // loop-measured poses relative to this keyframe within the tolerances below of the map's. Where one
+  // of those does not see the place (a drive that ends where it began: the keyframes before the last
+  // are behind the first keyframe, and the pyramid's 3.6x scale range does not reach the places it
+  // saw), this keyframe verified against the matched keyframe's best covisible ones counts instead,
+  // its pose from each within the same tolerances of the first verification's. A keyframe that sees
+  // the place but disagrees refuses the loop.
   int consistent_keyframes = 3;
+  std::size_t matched_side_keyframes = 5;  // covisible keyframes of the matched one tried so
   double consistency_tolerance_m = 0.2;
   double consistency_tolerance_deg = 1.0;
   // A verified loop changes the map only when the map disagrees with it by more than this: about 5x the
@@ -79,7 +86,7 @@ struct LoopClosingOptions {
   int fusion_neighbours = 10;
   FusionOptions fusion;
   // Bundle adjustment of the whole map after a closure (its spanning-tree root held fixed).
-  bool global_ba = true;
+  bool global_ba = false;
   BundleAdjustmentOptions global_ba_options = {.iterations = 10, .dense_schur = false};
 
   void validate() const;
