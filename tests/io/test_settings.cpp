@@ -141,7 +141,7 @@ TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
   const auto s = rgbl::read_settings(
       tmp.write("loop.yaml", "%YAML:1.0\nLoopClosing.Enabled: 0\nLoopClosing.MaxPlaceDistance: 0.3\n"
                              "LoopClosing.ConsistentKeyframes: 4\nLoopClosing.MaxDriftPercent: 5\n"
-                             "LoopClosing.MaxDriftDegPer100m: 4.5\nLoopClosing.Fuse: 1\nLoopClosing.GlobalBA: 0\n"
+                             "LoopClosing.MaxDriftDegPer100m: 4.5\nLoopClosing.Fuse: 1\nLoopClosing.GlobalBA: 1\n"
                              "LoopClosing.MergeMaps: 0\n"));
   CHECK(s.loop_closing.enabled == false);
   CHECK(s.loop_closing.max_place_distance == 0.3);
@@ -149,7 +149,7 @@ TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
   CHECK(s.loop_closing.max_drift_percent == 5.0);
   CHECK(s.loop_closing.max_drift_deg_per_100m == 4.5);
   CHECK(s.loop_closing.fuse == true);
-  CHECK(s.loop_closing.global_ba == false);
+  CHECK(s.loop_closing.global_ba == true);  // off by default
   CHECK(s.loop_closing.merge_maps == false);
   CHECK(s.warnings.empty());
   CHECK_THAT(error_of(tmp.write("l1.yaml", "%YAML:1.0\nLoopClosing.Enabled: 2\n")),
