@@ -96,15 +96,15 @@ bool plausible_drift(const LoopClosingOptions& o, PoseChange asked, double drive
          asked.deg <= o.drift_allowance_deg + 0.01 * o.max_drift_deg_per_100m * driven_m;
 }
 
-// The loop must hold for more keyframe pairs than the one that found it (ORB-SLAM3 checks covisible
-// keyframes already in the map rather than waiting for new ones, which a loop ending where the drive
-// ends never brings). First the keyframes before `current`: each verifies against the same matched
-// keyframe by a guided search from the pose the loop implies for it, and its measured pose relative
-// to `current` must agree with the map's, which odometry knows to centimetres over a few keyframes.
-// One that does not see the place is skipped (one that sees it and disagrees refuses the loop); then
-// `current` against the matched keyframe's best covisible ones, each measuring current's pose again
-// from other keyframes' landmarks, within the same tolerances. The loop constraints of the pairs that
-// confirmed (LoopClosingOptions::consistent_keyframes - 1 of them), or nullopt.
+// The loop must hold for more keyframe pairs than the one that found it (ORB-SLAM3 checks keyframes
+// already in the map rather than waiting for new ones, which a loop ending where the drive ends never
+// brings). Each pair is a guided verification of keyframe k against keyframe m from the pose the loop
+// implies for k, and the pose it measures must be within the tolerances of that guess: for a keyframe
+// before `current` this compares its loop-measured pose relative to `current` with the map's, which
+// odometry knows to centimetres over a few keyframes. The keyframes before `current` are tried against
+// the matched keyframe first, then `current` against the matched keyframe's best covisible ones. A
+// pair that does not see the place is skipped; one that sees it and disagrees refuses the loop. The
+// loop constraints of the consistent_keyframes - 1 pairs that confirmed, or nullopt.
 std::optional<std::vector<LoopConstraint>> confirm(const PinholeCamera& camera, const LoopClosingOptions& options,
                                                    const Map& map, const Keyframe& current, const Verified& loop,
                                                    std::span<const KeyframeId> previous) {
@@ -112,48 +112,36 @@ std::optional<std::vector<LoopConstraint>> confirm(const PinholeCamera& camera, 
   const KeyframeId matched = loop.verification.constraint.matched;
   const auto needed = static_cast<std::size_t>(options.consistent_keyframes - 1);
   std::vector<LoopConstraint> constraints;
-  const auto agrees = [&](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, KeyframeId with,
-                          KeyframeId against) {
-    const PoseChange disagreement = pose_change(a, b);
-    if (disagreement.m <= options.consistency_tolerance_m && disagreement.deg <= options.consistency_tolerance_deg) {
+  // false: the pair saw the place and disagrees
+  const auto attempt = [&](const Keyframe& k, KeyframeId against, const Eigen::Isometry3d& T_k_world_guess) {
+    LoopVerificationCounts counts;
+    const auto again = verify_loop_guided(camera, k, map, against, T_k_world_guess, options.verification, &counts);
+    if (!again) {
+      logger()->debug("loop: keyframe {} vs {} does not confirm keyframe {} vs {} ({} matches, {} guided, {} inliers)",
+                      k.id.value, against.value, current.id.value, matched.value, counts.matches,
+                      counts.guided_matches, counts.inliers);
       return true;
     }
-    logger()->debug("loop: keyframe {} vs {} disagrees with keyframe {} vs {} by {:.3f} m, {:.2f} deg", with.value,
-                    against.value, current.id.value, matched.value, disagreement.m, disagreement.deg);
-    return false;
+    const PoseChange disagreement = pose_change(T_k_world_guess, again->T_cam_world);
+    if (disagreement.m > options.consistency_tolerance_m || disagreement.deg > options.consistency_tolerance_deg) {
+      logger()->debug("loop: keyframe {} vs {} disagrees with keyframe {} vs {} by {:.3f} m, {:.2f} deg", k.id.value,
+                      against.value, current.id.value, matched.value, disagreement.m, disagreement.deg);
+      return false;
+    }
+    constraints.push_back(again->constraint);
+    return true;
   };
   for (const KeyframeId id : previous) {
     if (constraints.size() >= needed) break;
     const Keyframe& k = *map.keyframe(id);
-    const Eigen::Isometry3d T_k_cur_map = k.T_cam_world * current.T_cam_world.inverse();
-    LoopVerificationCounts counts;
-    const auto again =
-        verify_loop_guided(camera, k, map, matched, T_k_cur_map * T_cur_world_loop, options.verification, &counts);
-    if (!again) {
-      logger()->debug("loop: keyframe {} verified keyframe {} but keyframe {} does not ({} matches, {} guided, {} "
-                      "inliers)",
-                      current.id.value, matched.value, id.value, counts.matches, counts.guided_matches, counts.inliers);
-      continue;
-    }
-    // T_k_cur measured through the loop against the map's: equal when both are right
-    if (!agrees(T_k_cur_map, again->T_cam_world * T_cur_world_loop.inverse(), id, matched)) return std::nullopt;
-    constraints.push_back(again->constraint);
+    // where the loop puts k: its pose relative to current as the map has it
+    if (!attempt(k, matched, k.T_cam_world * current.T_cam_world.inverse() * T_cur_world_loop)) return std::nullopt;
   }
   if (constraints.size() < needed) {
     for (const KeyframeId other : map.best_covisible(matched, options.matched_side_keyframes)) {
       if (constraints.size() >= needed) break;
       if (current.covisibility.contains(other)) continue;
-      LoopVerificationCounts counts;
-      const auto again = verify_loop_guided(camera, current, map, other, T_cur_world_loop, options.verification, &counts);
-      if (!again) {
-        logger()->debug("loop: keyframe {} verified keyframe {} but not its neighbour {} ({} matches, {} guided, {} "
-                        "inliers)",
-                        current.id.value, matched.value, other.value, counts.matches, counts.guided_matches,
-                        counts.inliers);
-        continue;
-      }
-      if (!agrees(T_cur_world_loop, again->T_cam_world, current.id, other)) return std::nullopt;
-      constraints.push_back(again->constraint);
+      if (!attempt(current, other, T_cur_world_loop)) return std::nullopt;
     }
   }
   if (constraints.size() < needed) return std::nullopt;
@@ -195,11 +183,10 @@ void merge_maps(Map& map, KeyframeId root, KeyframeId matched, const Eigen::Isom
     Keyframe& kf = *map.keyframe(k);
     kf.T_cam_world = kf.T_cam_world * T_new_old;
   }
-  for (const LandmarkId l : landmarks) {
-    Landmark& lm = *map.landmark(l);
-    lm.position = T_old_new * lm.position;
+  for (const LandmarkId l : landmarks) {  // after the keyframes: the viewing directions use their poses
+    map.landmark(l)->position = T_old_new * map.landmark(l)->position;
+    map.update_landmark(l);
   }
-  for (const LandmarkId l : landmarks) map.update_landmark(l);
   map.keyframe(root)->parent = matched;
 }
 
@@ -255,7 +242,7 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
 
   std::optional<Verified> best;
   std::vector<LoopConstraint> confirmed;  // the earlier keyframes' verifications of the same loop
-  KeyframeId current_root;
+  KeyframeId root;  // of the current keyframe's map
   bool merge = false;  // the loop joins another map
   {
     std::shared_lock lock(map.mutex());
@@ -263,8 +250,7 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
     if (current == nullptr) return done();
     const double driven = record_odometry(keyframe, current->center());
     Roots roots(map);
-    current_root = roots(keyframe);
-    const KeyframeId root = current_root;
+    root = roots(keyframe);
     const auto allowed = [&](std::size_t id) {
       const KeyframeId candidate{static_cast<int>(id)};
       return candidate.value <= keyframe.value - options_.min_keyframe_gap && map.keyframe(candidate) != nullptr &&
@@ -352,7 +338,7 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
     // from the matched keyframe: one spanning tree, which the pose graph and bundle adjustment below
     // then treat as one map.
     const Eigen::Isometry3d T_old_new = best->verification.T_cam_world.inverse() * T_cam_world_before;
-    merge_maps(map, current_root, closure.matched, T_old_new);
+    merge_maps(map, root, closure.matched, T_old_new);
     closure.merged = true;
     ++stats_.merges;
   }

@@ -89,24 +89,30 @@ Run track(const Lap& lap, bool loop_closing) {
   return track(lap, options);
 }
 
+// Every frame tracked ok and every closure true: its two frames within a few metres of each other in
+// the truth, and not before frame `first` (where the drive first comes back). The number of closures.
+int check_closures(const Lap& lap, const Run& run, std::size_t first) {
+  int closures = 0;
+  for (const auto& r : run.results) {
+    CHECK(r.state == rgbl::TrackState::Ok);
+    if (!r.loop_closure) continue;
+    ++closures;
+    const auto& c = *r.loop_closure;
+    const double apart = (lap.truth[c.frame_index].translation() - lap.truth[c.matched_frame_index].translation()).norm();
+    CAPTURE(c.frame_index, c.matched_frame_index, apart, c.correction_m, c.correction_deg);
+    CHECK(apart < 10.0);
+    CHECK(c.frame_index >= first);
+  }
+  return closures;
+}
+
 }  // namespace
 
 TEST_CASE("loop closer: two laps of the simulator's loop are closed where the places are the same") {
   const Lap& lap = two_laps();
   const Run with = track(lap, true);
   const Run without = track(lap, false);
-  int closures = 0;
-  for (const auto& r : with.results) {
-    CHECK(r.state == rgbl::TrackState::Ok);
-    if (!r.loop_closure) continue;
-    ++closures;
-    // a true closure: the two frames are within a few metres of each other in the truth
-    const auto& c = *r.loop_closure;
-    const double apart = (lap.truth[c.frame_index].translation() - lap.truth[c.matched_frame_index].translation()).norm();
-    CAPTURE(c.frame_index, c.matched_frame_index, apart, c.correction_m, c.correction_deg);
-    CHECK(apart < 10.0);
-    CHECK(c.frame_index >= 100);  // nothing before the first lap is done
-  }
+  const int closures = check_closures(lap, with, 100);  // nothing before the first lap is done
   fmt::print("two laps of a 100 m loop: {} closures, ATE {:.3f} m (without loop closing {:.3f} m)\n", closures, with.ate,
              without.ate);
   // measured: 1 closure (the map agrees with the loop afterwards), ATE 0.099 m against 1.438 m (0.079 m
@@ -129,17 +135,7 @@ TEST_CASE("loop closer: a drive that ends where it began is closed at its last k
   const Lap lap = generate(options);
   const Run with = track(lap, true);
   const Run without = track(lap, false);
-  int closures = 0;
-  for (const auto& r : with.results) {
-    CHECK(r.state == rgbl::TrackState::Ok);
-    if (!r.loop_closure) continue;
-    ++closures;
-    const auto& c = *r.loop_closure;
-    const double apart = (lap.truth[c.frame_index].translation() - lap.truth[c.matched_frame_index].translation()).norm();
-    CAPTURE(c.frame_index, c.matched_frame_index, apart);
-    CHECK(apart < 10.0);
-    CHECK(c.frame_index >= 70);
-  }
+  const int closures = check_closures(lap, with, 70);
   fmt::print("one lap of a 79 m loop: {} closures, ATE {:.3f} m (without loop closing {:.3f} m)\n", closures, with.ate,
              without.ate);
   // measured: 1 closure (frame 77 with frame 0), ATE 0.157 m against 0.303 m

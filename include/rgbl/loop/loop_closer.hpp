@@ -54,7 +54,7 @@ struct LoopClosingOptions {
   // its pose from each within the same tolerances of the first verification's. A keyframe that sees
   // the place but disagrees refuses the loop.
   int consistent_keyframes = 3;
-  std::size_t matched_side_keyframes = 5;  // covisible keyframes of the matched one tried so
+  std::size_t matched_side_keyframes = 5;  // best covisible keyframes of the matched one tried (0: none)
   double consistency_tolerance_m = 0.2;
   double consistency_tolerance_deg = 1.0;
   // A verified loop changes the map only when the map disagrees with it by more than this: about 5x the
@@ -116,7 +116,7 @@ struct LoopCloserStep {
   int candidates = 0;      // places below max_place_distance that were verified
   int verified = 0;        // of those, verified geometrically
   int implausible = 0;     // of those, refused: more correction than odometry can have drifted
-  bool consistent = false; // a loop verified by consistent_keyframes consecutive keyframes that agree
+  bool consistent = false; // a loop confirmed by consistent_keyframes keyframe pairs that agree
   double time_ms = 0.0;
   std::optional<LoopClosure> closure;
 };
@@ -127,7 +127,7 @@ struct LoopClosingStats {
   int candidates = 0;   // places verified
   int verified = 0;     // verified geometrically
   int implausible = 0;  // verified, but refused: more correction than odometry can have drifted
-  int consistent = 0;   // keyframes whose best loop held over consistent_keyframes keyframes
+  int consistent = 0;   // keyframes whose best loop held over consistent_keyframes keyframe pairs
   int confirming = 0;   // of those, loops that agreed with the map (no correction)
   int closures = 0;     // of those, loops the map was corrected with
   int merges = 0;       // of those, closures that joined two maps
