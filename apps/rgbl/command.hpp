@@ -19,5 +19,6 @@ Command add_info_command(CLI::App& parent);
 Command add_run_command(CLI::App& parent);
 Command add_depth_command(CLI::App& parent);
 Command add_demo_command(CLI::App& parent);
+Command add_vocab_command(CLI::App& parent);
 
 }  // namespace rgbl::cli

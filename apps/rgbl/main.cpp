@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
       rgbl::cli::add_demo_command(app),
       rgbl::cli::add_info_command(app),
       rgbl::cli::add_eval_command(app),
+      rgbl::cli::add_vocab_command(app),
   };
 
   try {

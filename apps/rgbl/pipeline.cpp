@@ -98,7 +98,9 @@ void apply_settings(const Settings& s, Pipeline& p) {
   LoopClosingOptions& loop = p.system.loop_closing;
   const LoopClosingSettings& l = s.loop_closing;
   if (l.enabled) loop.enabled = *l.enabled;
-  if (l.max_place_distance) loop.max_place_distance = *l.max_place_distance;
+  if (l.max_place_distance) loop.places.scan_context.max_distance = *l.max_place_distance;
+  if (l.places) loop.places.methods = *l.places;
+  if (l.vocabulary) loop.places.bow.vocabulary = l.vocabulary->string();
   if (l.consistent_keyframes) loop.consistent_keyframes = *l.consistent_keyframes;
   if (l.max_drift_percent) loop.max_drift_percent = *l.max_drift_percent;
   if (l.max_drift_deg_per_100m) loop.max_drift_deg_per_100m = *l.max_drift_deg_per_100m;

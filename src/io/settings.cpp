@@ -285,6 +285,25 @@ Settings read_settings(const std::filesystem::path& yaml) {
   };
   s.loop_closing.enabled = flag("LoopClosing.Enabled");
   s.loop_closing.max_place_distance = r.number({"LoopClosing.MaxPlaceDistance"});
+  if (const auto v = r.string({"LoopClosing.Places"})) {
+    std::vector<std::string> methods;
+    std::string name;
+    for (const char c : *v + ",") {
+      if (c == ',') {
+        if (name.empty()) r.fail("LoopClosing.Places", "place recogniser names separated by commas, e.g. \"scan_context,bow\"");
+        methods.push_back(name);
+        name.clear();
+      } else if (c != ' ') {
+        name += c;
+      }
+    }
+    s.loop_closing.places = methods;
+  }
+  if (const auto v = r.string({"LoopClosing.Vocabulary"})) {
+    if (v->empty()) r.fail("LoopClosing.Vocabulary", "a vocabulary file (written by `rgbl vocab train`)");
+    const std::filesystem::path p = *v;
+    s.loop_closing.vocabulary = p.is_absolute() ? p : yaml.parent_path() / p;
+  }
   s.loop_closing.consistent_keyframes = r.integer({"LoopClosing.ConsistentKeyframes"});
   s.loop_closing.max_drift_percent = r.number({"LoopClosing.MaxDriftPercent"});
   s.loop_closing.max_drift_deg_per_100m = r.number({"LoopClosing.MaxDriftDegPer100m"});

@@ -21,10 +21,7 @@
 namespace rgbl {
 
 void LoopClosingOptions::validate() const {
-  scan_context.validate();
-  require(max_place_distance > 0.0 && max_place_distance <= 1.0, "loop_closing.max_place_distance",
-          "a Scan Context distance in (0, 1]");
-  require(ring_key_neighbours >= 1, "loop_closing.ring_key_neighbours", ">= 1 place");
+  places.validate();
   require(max_candidates >= 1, "loop_closing.max_candidates", ">= 1 candidate");
   require(min_keyframe_gap >= 1, "loop_closing.min_keyframe_gap", ">= 1 keyframe");
   require(consistent_keyframes >= 1, "loop_closing.consistent_keyframes", ">= 1 keyframe");
@@ -78,7 +75,7 @@ class Roots {
 
 struct Verified {
   LoopVerification verification;
-  double place_distance = 0.0;
+  PlaceCandidate place;
 };
 
 // How far camera pose b is from a: centre distance and rotation angle.
@@ -195,6 +192,12 @@ void merge_maps(Map& map, KeyframeId root, KeyframeId matched, const Eigen::Isom
 LoopCloser::LoopCloser(const PinholeCamera& camera, LoopClosingOptions options)
     : camera_(camera), options_(std::move(options)) {
   options_.validate();
+  for (const std::string& method : options_.places.methods) places_.push_back(make_place_recognizer(method, options_.places));
+}
+
+void LoopCloser::add_place_recognizer(std::unique_ptr<PlaceRecognizer> recognizer) {
+  if (!recognizer) throw ConfigError("loop_closing.places", "a place recogniser, not null");
+  places_.push_back(std::move(recognizer));
 }
 
 void LoopCloser::adjust_map(Map& map, KeyframeId keyframe, LoopClosure& closure) const {
@@ -233,13 +236,7 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
     step.time_ms = watch.elapsed_ms();
     return step;
   };
-  if (scan.empty()) {
-    remember(keyframe);  // no place to recognise, but later loops may ask it to confirm
-    return done();
-  }
-  ScanContext context = make_scan_context(scan, options_.scan_context);
   ++stats_.keyframes;
-
   std::optional<Verified> best;
   std::vector<LoopConstraint> confirmed;  // the earlier keyframes' verifications of the same loop
   KeyframeId root;  // of the current keyframe's map
@@ -256,20 +253,33 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
       return candidate.value <= keyframe.value - options_.min_keyframe_gap && map.keyframe(candidate) != nullptr &&
              !current->covisibility.contains(candidate) && (options_.merge_maps || roots(candidate) == root);
     };
-    // Places of every map: one of another map (started after a loss) is a merge candidate.
-    std::vector<std::pair<KeyframeId, double>> candidates;  // with their place distance
-    for (const auto& place : places_.query(context, options_.ring_key_neighbours, allowed)) {
-      if (place.match.distance > options_.max_place_distance) break;  // sorted, best first
-      if (std::cmp_greater_equal(candidates.size(), options_.max_candidates)) break;
-      candidates.emplace_back(KeyframeId{static_cast<int>(place.id)}, place.match.distance);
+    std::vector<std::size_t> neighbours;
+    for (const auto& [k, weight] : current->covisibility) neighbours.push_back(static_cast<std::size_t>(k.value));
+    const PlaceQuery query{static_cast<std::size_t>(keyframe.value), scan, current->descriptors, neighbours};
+    // Places of every map (one of another map, started after a loss, is a merge candidate), each
+    // recogniser's best in turn: its first, then every second, and so on; a place two name is
+    // verified once.
+    std::vector<std::vector<PlaceCandidate>> proposed;
+    for (const auto& recognizer : places_) proposed.push_back(recognizer->query(query, allowed, options_.max_candidates));
+    std::vector<PlaceCandidate> candidates;
+    for (std::size_t rank = 0; rank < options_.max_candidates; ++rank) {
+      for (const auto& list : proposed) {
+        if (rank >= list.size()) continue;
+        const PlaceCandidate& c = list[rank];
+        if (std::none_of(candidates.begin(), candidates.end(), [&](const auto& o) { return o.id == c.id; })) {
+          candidates.push_back(c);
+        }
+      }
     }
-    for (const auto& [candidate, place_distance] : candidates) {
+    for (const PlaceCandidate& place : candidates) {
+      const KeyframeId candidate{static_cast<int>(place.id)};
       ++step.candidates;
       LoopVerificationCounts counts;
       auto verified = verify_loop(camera_, *current, map, candidate, options_.verification, &counts);
-      logger()->debug("loop: keyframe {} vs {}{} (place {:.3f}): {} matches, {} RANSAC inliers, {} guided, {} "
+      logger()->debug("loop: keyframe {} vs {}{} ({} {:.3f}): {} matches, {} RANSAC inliers, {} guided, {} "
                       "inliers{}",
-                      keyframe.value, candidate.value, roots(candidate) == root ? "" : " of another map", place_distance,
+                      keyframe.value, candidate.value, roots(candidate) == root ? "" : " of another map", place.source,
+                      place.similarity,
                       counts.matches, counts.ransac_inliers, counts.guided_matches, counts.inliers,
                       verified ? ": verified" : "");
       if (!verified) continue;
@@ -284,7 +294,7 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
         continue;
       }
       if (!best || verified->counts.inliers > best->verification.counts.inliers) {
-        best = Verified{std::move(*verified), place_distance};
+        best = Verified{std::move(*verified), place};
       }
     }
     if (best) {
@@ -299,8 +309,8 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
       }
       merge = roots(best->verification.constraint.matched) != root;
     }
+    for (const auto& recognizer : places_) recognizer->add(query);  // under the lock: reads the descriptors
   }
-  places_.add(static_cast<std::size_t>(keyframe.value), std::move(context));
   remember(keyframe);
   stats_.candidates += step.candidates;
   stats_.verified += step.verified;
@@ -331,7 +341,8 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
   closure.matched = best->verification.constraint.matched;
   closure.frame_index = map.keyframe(keyframe)->frame_index;
   closure.matched_frame_index = map.keyframe(closure.matched)->frame_index;
-  closure.place_distance = best->place_distance;
+  closure.place_source = std::string(best->place.source);
+  closure.place_similarity = best->place.similarity;
   closure.inliers = best->verification.counts.inliers;
   if (merge) {
     // The current map moves rigidly onto the matched one (metric depth: no scale), and its root hangs
@@ -350,10 +361,10 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
   closure.correction_m = moved.m;
   closure.correction_deg = moved.deg;
   closure.time_ms = watch.elapsed_ms();
-  logger()->info("{}: frame {} with frame {} (place {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
+  logger()->info("{}: frame {} with frame {} ({} {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
                  "loop error {:.2f} -> {:.3f} m, {} landmarks fused, global BA {} keyframes {:.0f} ms, {:.0f} ms",
                  closure.merged ? "maps merged" : "loop closed", closure.frame_index, closure.matched_frame_index,
-                 closure.place_distance, closure.inliers, closure.correction_m, closure.correction_deg,
+                 closure.place_source, closure.place_similarity, closure.inliers, closure.correction_m, closure.correction_deg,
                  closure.correction.loop_error_before_m, closure.correction.loop_error_after_m, closure.fused_landmarks, closure.global_ba_keyframes,
                  closure.global_ba_ms, closure.time_ms);
   step.closure = closure;

@@ -142,8 +142,11 @@ TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
       tmp.write("loop.yaml", "%YAML:1.0\nLoopClosing.Enabled: 0\nLoopClosing.MaxPlaceDistance: 0.3\n"
                              "LoopClosing.ConsistentKeyframes: 4\nLoopClosing.MaxDriftPercent: 5\n"
                              "LoopClosing.MaxDriftDegPer100m: 4.5\nLoopClosing.Fuse: 1\nLoopClosing.GlobalBA: 1\n"
-                             "LoopClosing.MergeMaps: 0\n"));
+                             "LoopClosing.MergeMaps: 0\nLoopClosing.Places: \"scan_context, bow\"\n"
+                             "LoopClosing.Vocabulary: \"voc/mine.rgblvoc\"\n"));
   CHECK(s.loop_closing.enabled == false);
+  CHECK(s.loop_closing.places == std::vector<std::string>{"scan_context", "bow"});
+  CHECK(s.loop_closing.vocabulary == tmp.path() / "voc/mine.rgblvoc");  // relative to the settings file
   CHECK(s.loop_closing.max_place_distance == 0.3);
   CHECK(s.loop_closing.consistent_keyframes == 4);
   CHECK(s.loop_closing.max_drift_percent == 5.0);
@@ -156,6 +159,10 @@ TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
              Contains("'LoopClosing.Enabled': expected 0 (off) or 1 (on)"));
   CHECK_THAT(error_of(tmp.write("l2.yaml", "%YAML:1.0\nLoopClosing.MaxPlaceDistance: 1.5\n")),
              Contains("'LoopClosing.MaxPlaceDistance': expected a Scan Context distance in (0, 1]"));
+  CHECK_THAT(error_of(tmp.write("l4.yaml", "%YAML:1.0\nLoopClosing.Places: \"bow,\"\n")),
+             Contains("'LoopClosing.Places': expected place recogniser names separated by commas"));
+  CHECK_THAT(error_of(tmp.write("l5.yaml", "%YAML:1.0\nLoopClosing.Vocabulary: \"\"\n")),
+             Contains("'LoopClosing.Vocabulary': expected a vocabulary file"));
   CHECK_THAT(error_of(tmp.write("l3.yaml", "%YAML:1.0\nLoopClosing.ConsistentKeyframes: 0\n")),
              Contains("'LoopClosing.ConsistentKeyframes': expected a count >= 1"));
   CHECK_THAT(error_of(tmp.write("l4.yaml", "%YAML:1.0\nLoopClosing.MaxDriftPercent: -1\n")),

@@ -145,10 +145,13 @@ TEST_CASE("loop closing options are checked, naming the field") {
     change(o);
     CHECK_THROWS_WITH(o.validate(), Catch::Contains(key));
   };
-  refused([](auto& o) { o.max_place_distance = 0.0; }, "loop_closing.max_place_distance");
+  refused([](auto& o) { o.places.scan_context.max_distance = 0.0; }, "loop_closing.places.scan_context.max_distance");
+  refused([](auto& o) { o.places.methods = {"netvlad"}; }, "loop_closing.places");
+  refused([](auto& o) { o.places.methods = {"bow", "bow"}; }, "loop_closing.places");
+  refused([](auto& o) { o.places.bow.min_score = 1.0; }, "loop_closing.places.bow.min_score");
   refused([](auto& o) { o.consistent_keyframes = 0; }, "loop_closing.consistent_keyframes");
   refused([](auto& o) { o.verification.guided_radius_px = 0.0; }, "loop_verification.guided_radius_px");
-  refused([](auto& o) { o.scan_context.sectors = 1; }, "scan_context.sectors");
+  refused([](auto& o) { o.places.scan_context.descriptor.sectors = 1; }, "scan_context.sectors");
   refused([](auto& o) { o.fusion_neighbours = -1; }, "loop_closing.fusion_neighbours");
   refused([](auto& o) { o.fusion.radius_px = 0.0; }, "fusion.radius_px");
   refused([](auto& o) { o.global_ba_options.iterations = 0; }, "bundle_adjustment.iterations");

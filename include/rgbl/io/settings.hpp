@@ -44,6 +44,8 @@ struct OrbSettings {
 struct LoopClosingSettings {
   std::optional<bool> enabled;
   std::optional<double> max_place_distance;
+  std::optional<std::vector<std::string>> places;  // LoopClosing.Places: "scan_context,bow"
+  std::optional<std::filesystem::path> vocabulary;  // LoopClosing.Vocabulary, relative to the settings file
   std::optional<int> consistent_keyframes;
   std::optional<double> max_drift_percent;
   std::optional<double> max_drift_deg_per_100m;

@@ -1,6 +1,6 @@
 #pragma once
 // Loop closing, one keyframe at a time: a place is recognised from the keyframe's LiDAR scan (Scan
-// Context, no training), the candidates are verified geometrically with metric depth, a loop is
+// Context, no training) and from its ORB descriptors (a bag of binary words), the candidates are verified geometrically with metric depth, a loop is
 // accepted only when consecutive keyframes verify it, and the map is then corrected by pose-graph
 // optimisation over the essential graph (keyframes and landmarks move together; frames tracked
 // against a keyframe follow it).
@@ -14,7 +14,7 @@
 // current map moves rigidly onto the other, its root hangs from the matched keyframe, and the same
 // correction follows.
 //
-// Not here yet (issue 14): a bag of words for depth sources without a scan, a thread of its own.
+// Not here yet (issue 14): a thread of its own.
 
 #include "rgbl/backend/bundle_adjustment.hpp"
 #include "rgbl/backend/loop_correction.hpp"
@@ -23,11 +23,13 @@
 #include "rgbl/loop/verification.hpp"
 #include "rgbl/map/fusion.hpp"
 #include "rgbl/map/map.hpp"
-#include "rgbl/place/scan_context.hpp"
+#include "rgbl/place/place_recognition.hpp"
 
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <memory>
+#include <string>
 #include <optional>
 #include <vector>
 
@@ -35,13 +37,10 @@ namespace rgbl {
 
 struct LoopClosingOptions {
   bool enabled = true;
-  ScanContextOptions scan_context;
-  // Scan Context distance (0 same, 1 unrelated) below which a place is a candidate. On real sequence 04
-  // consecutive scans (1.35 m) score at most 0.20 and scans >= 25 frames (~34 m) apart at least 0.49;
-  // the same scan turned by half a sector scores 0.175. Verification, not this bound, decides.
-  double max_place_distance = 0.35;
-  std::size_t ring_key_neighbours = 10;  // places compared in full per query
-  std::size_t max_candidates = 3;        // best places verified per keyframe
+  // Place recognition: the candidates of every recogniser named in places.methods (Scan Context on
+  // the keyframe's LiDAR scan, a bag of words on its descriptors) are fused and verified.
+  PlaceRecognitionOptions places;
+  std::size_t max_candidates = 3;  // best places verified per keyframe and recogniser
   // Candidates are keyframes at least this many keyframes older than the query and not covisible with
   // it: a recent keyframe is the local map's business, not a loop's.
   int min_keyframe_gap = 10;
@@ -98,7 +97,8 @@ struct LoopClosure {
   std::size_t matched_frame_index = 0;  // of the older keyframe it matched
   KeyframeId current, matched;
   bool merged = false;                  // the loop joined two maps (matched lies in the older one)
-  double place_distance = 0.0;          // Scan Context distance of the match
+  std::string place_source;             // the recogniser that found the matched place
+  double place_similarity = 0.0;        // its score for it, in [0, 1]
   int inliers = 0;                      // of the verification
   double correction_m = 0.0;            // how far the current keyframe moved
   double correction_deg = 0.0;          // and turned
@@ -113,7 +113,7 @@ struct LoopClosure {
 
 // What one keyframe did in the loop closer (also when nothing was closed).
 struct LoopCloserStep {
-  int candidates = 0;      // places below max_place_distance that were verified
+  int candidates = 0;      // places the recognisers proposed, verified
   int verified = 0;        // of those, verified geometrically
   int implausible = 0;     // of those, refused: more correction than odometry can have drifted
   bool consistent = false; // a loop confirmed by consistent_keyframes keyframe pairs that agree
@@ -123,7 +123,7 @@ struct LoopCloserStep {
 
 // The loop closer's counts over a run (what it considered, not only what it closed).
 struct LoopClosingStats {
-  int keyframes = 0;    // processed with a scan
+  int keyframes = 0;    // processed
   int candidates = 0;   // places verified
   int verified = 0;     // verified geometrically
   int implausible = 0;  // verified, but refused: more correction than odometry can have drifted
@@ -135,10 +135,14 @@ struct LoopClosingStats {
 
 class LoopCloser {
  public:
+  // Creates the recognisers options.places.methods names (ConfigError / ParseError as
+  // make_place_recognizer).
   LoopCloser(const PinholeCamera& camera, LoopClosingOptions options);
+  // Adds a recogniser of your own; its candidates are fused with the others'. Before the first process().
+  void add_place_recognizer(std::unique_ptr<PlaceRecognizer> recognizer);
 
   // Call once per new keyframe, in order, after local mapping has processed it. `scan` is the
-  // keyframe's LiDAR scan (empty: no place recognition for it). Takes the map's lock itself: shared
+  // keyframe's LiDAR scan (empty: only the recognisers that need none see it). Takes the map's lock itself: shared
   // while detecting, exclusive while correcting.
   LoopCloserStep process(Map& map, KeyframeId keyframe, PointCloudView scan);
 
@@ -150,7 +154,7 @@ class LoopCloser {
  private:
   PinholeCamera camera_;
   LoopClosingOptions options_;
-  ScanContextDatabase places_;
+  std::vector<std::unique_ptr<PlaceRecognizer>> places_;
   std::vector<LoopConstraint> loops_;
   LoopClosingStats stats_;
   // Distance driven up to each processed keyframe (by id; NaN: not processed), along the keyframes as
