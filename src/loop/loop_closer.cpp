@@ -254,7 +254,9 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
              !current->covisibility.contains(candidate) && (options_.merge_maps || roots(candidate) == root);
     };
     std::vector<std::size_t> neighbours;
-    for (const auto& [k, weight] : current->covisibility) neighbours.push_back(static_cast<std::size_t>(k.value));
+    for (const KeyframeId k : map.best_covisible(keyframe, options_.place_neighbours)) {
+      neighbours.push_back(static_cast<std::size_t>(k.value));
+    }
     const PlaceQuery query{static_cast<std::size_t>(keyframe.value), scan, current->descriptors, neighbours};
     // Places of every map (one of another map, started after a loss, is a merge candidate), each
     // recogniser's best in turn: its first, then every second, and so on; a place two name is

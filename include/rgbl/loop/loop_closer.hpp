@@ -41,6 +41,10 @@ struct LoopClosingOptions {
   // the keyframe's LiDAR scan, a bag of words on its descriptors) are fused and verified.
   PlaceRecognitionOptions places;
   std::size_t max_candidates = 3;  // best places verified per keyframe and recogniser
+  // The keyframe's best covisible keyframes (most shared landmarks) shown to the recognisers as what
+  // the place looks like from nearby (the bag of words' bar: a candidate must look at least as similar
+  // as the least similar of them).
+  std::size_t place_neighbours = 10;
   // Candidates are keyframes at least this many keyframes older than the query and not covisible with
   // it: a recent keyframe is the local map's business, not a loop's.
   int min_keyframe_gap = 10;
