@@ -235,6 +235,7 @@ BowVector Vocabulary::transform(std::span<const Descriptor> descriptors) const {
     i = j;
   }
   for (auto& [word, w] : v) w = static_cast<float>(w / total);
+  std::erase_if(v, [](const auto& e) { return !(e.second > 0.0F); });  // underflow: a word far lighter than the rest
   return v;
 }
 
@@ -308,7 +309,8 @@ Vocabulary Vocabulary::from_bytes(std::span<const std::uint8_t> bytes, const std
       next_child += node.children;
       node.weight = 0.0F;
     } else {
-      if (!std::isfinite(node.weight) || node.weight < 0.0F) fail(fmt::format("node {} has weight {}", n, node.weight));
+      // an idf is log(images / images holding the word): >= 0, and below 100 for any training set
+      if (!(node.weight >= 0.0F && node.weight < 100.0F)) fail(fmt::format("node {} has weight {}", n, node.weight));
       node.word = static_cast<std::uint32_t>(v.leaves_.size());
       v.leaves_.push_back(n);
     }
