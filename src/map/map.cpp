@@ -111,14 +111,15 @@ void Map::erase_keyframe(KeyframeId keyframe_id) {
   for (const auto& [other, weight] : k->covisibility) {
     if (Keyframe* o = keyframe(other)) o->covisibility.erase(keyframe_id);
   }
-  // Re-attach children: to this keyframe's parent, or to their strongest remaining neighbour.
+  // Re-attach children: to their strongest remaining older neighbour, or to this keyframe's parent.
+  // A parent is always older than its child, so the tree never closes a cycle.
   KeyframeId new_parent = k->parent;
   for (auto& slot : keyframes_) {
     if (!slot || slot->parent != keyframe_id) continue;
     KeyframeId best = new_parent;
     int best_weight = -1;
     for (const auto& [other, weight] : slot->covisibility) {
-      if (other != keyframe_id && weight > best_weight && keyframe(other) != nullptr) {
+      if (other != keyframe_id && other < slot->id && weight > best_weight && keyframe(other) != nullptr) {
         best = other;
         best_weight = weight;
       }
@@ -211,16 +212,19 @@ void Map::update_covisibility(KeyframeId keyframe_id) {
     }
   }
   k->covisibility = counts;
+  // A keyframe without a parent hangs from its strongest older neighbour (older: the tree stays
+  // acyclic; with mapping in its own thread, newer keyframes may already share more landmarks). The
+  // first keyframe of a map has none and stays a root.
   KeyframeId strongest;
   int strongest_weight = 0;
   for (const auto& [other, weight] : counts) {
     if (Keyframe* o = keyframe(other)) o->covisibility[keyframe_id] = weight;
-    if (weight > strongest_weight) {
+    if (other < keyframe_id && weight > strongest_weight) {
       strongest_weight = weight;
       strongest = other;
     }
   }
-  if (!k->parent.valid() && strongest.valid() && strongest < keyframe_id) k->parent = strongest;
+  if (!k->parent.valid() && strongest.valid()) k->parent = strongest;
 }
 
 std::vector<KeyframeId> Map::best_covisible(KeyframeId keyframe_id, std::size_t n, int min_weight) const {
