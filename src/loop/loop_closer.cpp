@@ -229,18 +229,29 @@ void LoopCloser::remember(KeyframeId keyframe) {
 }
 
 LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView scan) {
+  std::optional<DetectedLoop> loop;
+  LoopCloserStep step = detect(map, keyframe, scan, loop);
+  if (loop) {
+    std::unique_lock lock(map.mutex());
+    correct(map, *loop, step);
+  }
+  return step;
+}
+
+LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView scan, std::optional<DetectedLoop>& loop) {
+  loop.reset();
   LoopCloserStep step;
   if (!options_.enabled) return step;
   const Stopwatch watch;
   const auto done = [&] {
     step.time_ms = watch.elapsed_ms();
+    stats_.time_ms += step.time_ms;
     return step;
   };
   ++stats_.keyframes;
   std::optional<Verified> best;
   std::vector<LoopConstraint> confirmed;  // the earlier keyframes' verifications of the same loop
   KeyframeId root;  // of the current keyframe's map
-  bool merge = false;  // the loop joins another map
   {
     std::shared_lock lock(map.mutex());
     const Keyframe* current = map.keyframe(keyframe);
@@ -309,7 +320,6 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
         step.consistent = true;
         confirmed = std::move(*constraints);
       }
-      merge = roots(best->verification.constraint.matched) != root;
     }
     for (const auto& recognizer : places_) recognizer->add(query);  // under the lock: reads the descriptors
   }
@@ -319,20 +329,40 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
   stats_.implausible += step.implausible;
   if (!step.consistent) return done();
   ++stats_.consistent;
+  loop = DetectedLoop{keyframe, best->verification, best->place, std::move(confirmed)};
+  return done();
+}
 
-  std::unique_lock lock(map.mutex());
+void LoopCloser::correct(Map& map, const DetectedLoop& loop, LoopCloserStep& step) {
+  const Stopwatch watch;
+  struct AddTime {  // on every return
+    LoopCloserStep& step;
+    double& total_ms;
+    const Stopwatch& watch;
+    ~AddTime() {
+      step.time_ms += watch.elapsed_ms();
+      total_ms += watch.elapsed_ms();
+    }
+  } add_time{step, stats_.time_ms, watch};
+  const KeyframeId keyframe = loop.keyframe;
+  const KeyframeId matched = loop.verification.constraint.matched;
+  // In a thread of its own, mapping may have culled either side since detection.
+  if (map.keyframe(keyframe) == nullptr || map.keyframe(matched) == nullptr) return;
+  Roots roots(map);
+  const KeyframeId root = roots(keyframe);
+  const bool merge = roots(matched) != root;
   const Eigen::Isometry3d T_cam_world_before = *map.keyframe_pose(keyframe);
   // How far the map is from the loop's measurement at the current keyframe.
-  const PoseChange disagreement = pose_change(T_cam_world_before, best->verification.T_cam_world);
+  const PoseChange disagreement = pose_change(T_cam_world_before, loop.verification.T_cam_world);
   if (!merge && disagreement.m <= options_.min_correction_m && disagreement.deg <= options_.min_correction_deg) {
     logger()->debug("loop: keyframe {} confirms keyframe {} ({:.3f} m, {:.2f} deg off): no correction", keyframe.value,
-                    best->verification.constraint.matched.value, disagreement.m, disagreement.deg);
+                    matched.value, disagreement.m, disagreement.deg);
     ++stats_.confirming;
-    return done();
+    return;
   }
   ++stats_.closures;
-  loops_.push_back(best->verification.constraint);
-  loops_.insert(loops_.end(), confirmed.begin(), confirmed.end());
+  loops_.push_back(loop.verification.constraint);
+  loops_.insert(loops_.end(), loop.confirmations.begin(), loop.confirmations.end());
   // Culling may have erased keyframes of earlier loops; their edges go with them.
   std::erase_if(loops_, [&](const LoopConstraint& l) {
     return map.keyframe(l.current) == nullptr || map.keyframe(l.matched) == nullptr;
@@ -340,29 +370,29 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
 
   LoopClosure closure;
   closure.current = keyframe;
-  closure.matched = best->verification.constraint.matched;
+  closure.matched = matched;
   closure.frame_index = map.keyframe(keyframe)->frame_index;
-  closure.matched_frame_index = map.keyframe(closure.matched)->frame_index;
-  closure.place_source = std::string(best->place.source);
-  closure.place_similarity = best->place.similarity;
-  closure.inliers = best->verification.counts.inliers;
+  closure.matched_frame_index = map.keyframe(matched)->frame_index;
+  closure.place_source = std::string(loop.place.source);
+  closure.place_similarity = loop.place.similarity;
+  closure.inliers = loop.verification.counts.inliers;
   if (merge) {
     // The current map moves rigidly onto the matched one (metric depth: no scale), and its root hangs
     // from the matched keyframe: one spanning tree, which the pose graph and bundle adjustment below
     // then treat as one map.
-    const Eigen::Isometry3d T_old_new = best->verification.T_cam_world.inverse() * T_cam_world_before;
-    merge_maps(map, root, closure.matched, T_old_new);
+    const Eigen::Isometry3d T_old_new = loop.verification.T_cam_world.inverse() * T_cam_world_before;
+    merge_maps(map, root, matched, T_old_new);
     closure.merged = true;
     ++stats_.merges;
   }
   closure.correction = correct_loops(map, loops_, options_.correction);
-  if (options_.fuse) closure.fused_landmarks = fuse_across(map, camera_, options_, keyframe, closure.matched);
+  if (options_.fuse) closure.fused_landmarks = fuse_across(map, camera_, options_, keyframe, matched);
   if (options_.global_ba) adjust_map(map, keyframe, closure);
   const PoseChange moved = pose_change(T_cam_world_before, *map.keyframe_pose(keyframe));
   last_centre_ = map.keyframe(keyframe)->center();  // odometry goes on from the corrected map
   closure.correction_m = moved.m;
   closure.correction_deg = moved.deg;
-  closure.time_ms = watch.elapsed_ms();
+  closure.time_ms = step.time_ms + watch.elapsed_ms();  // detection and correction
   logger()->info("{}: frame {} with frame {} ({} {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
                  "loop error {:.2f} -> {:.3f} m, {} landmarks fused, global BA {} keyframes {:.0f} ms, {:.0f} ms",
                  closure.merged ? "maps merged" : "loop closed", closure.frame_index, closure.matched_frame_index,
@@ -370,7 +400,6 @@ LoopCloserStep LoopCloser::process(Map& map, KeyframeId keyframe, PointCloudView
                  closure.correction.loop_error_before_m, closure.correction.loop_error_after_m, closure.fused_landmarks, closure.global_ba_keyframes,
                  closure.global_ba_ms, closure.time_ms);
   step.closure = closure;
-  return done();
 }
 
 }  // namespace rgbl

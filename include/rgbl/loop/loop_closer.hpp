@@ -125,6 +125,14 @@ struct LoopCloserStep {
   std::optional<LoopClosure> closure;
 };
 
+// A loop detect() confirmed, not yet applied to the map.
+struct DetectedLoop {
+  KeyframeId keyframe;                      // the current keyframe
+  LoopVerification verification;            // against the matched keyframe
+  PlaceCandidate place;                     // how the matched keyframe was found
+  std::vector<LoopConstraint> confirmations;  // of the keyframe pairs that confirmed it
+};
+
 // The loop closer's counts over a run (what it considered, not only what it closed).
 struct LoopClosingStats {
   int keyframes = 0;    // processed
@@ -135,6 +143,7 @@ struct LoopClosingStats {
   int confirming = 0;   // of those, loops that agreed with the map (no correction)
   int closures = 0;     // of those, loops the map was corrected with
   int merges = 0;       // of those, closures that joined two maps
+  double time_ms = 0.0; // detection, verification and correction over the run (threaded: off the tracking path)
 };
 
 class LoopCloser {
@@ -149,6 +158,15 @@ class LoopCloser {
   // keyframe's LiDAR scan (empty: only the recognisers that need none see it). Takes the map's lock itself: shared
   // while detecting, exclusive while correcting.
   LoopCloserStep process(Map& map, KeyframeId keyframe, PointCloudView scan);
+
+  // process() in two halves, for a loop closer in a thread of its own: detect() holds the map's lock
+  // shared (tracking and mapping go on) and fills `loop` with a confirmed loop that disagrees with the
+  // map, or leaves it empty; correct() applies it and must be called with the map's lock held
+  // exclusively, while neither mapping nor tracking is between reading and writing the map. It
+  // re-checks that both keyframes still exist (mapping may have culled one meanwhile) and may still
+  // find that the loop only confirms the map. Both add to `step`.
+  LoopCloserStep detect(Map& map, KeyframeId keyframe, PointCloudView scan, std::optional<DetectedLoop>& loop);
+  void correct(Map& map, const DetectedLoop& loop, LoopCloserStep& step);
 
   // Every loop the map has been corrected with (kept: later corrections must respect earlier loops).
   const std::vector<LoopConstraint>& loops() const { return loops_; }
