@@ -197,7 +197,7 @@ Command add_demo_command(CLI::App& parent) {
   app->add_option("--laps", args->laps, "Laps of --path loop in the frames driven (2: past the start and round again)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
-  app->add_flag("--threaded", args->threaded, "Local mapping in its own thread");
+  app->add_flag("--threaded", args->threaded, "Local mapping and loop closing in threads of their own");
   app->add_flag("--no-loop-closing", args->no_loop_closing, "Track without loop closing (to compare)");
   return {app, [args, app] {
             const bool quiet = app->get_parent()->get_option("--quiet")->as<bool>();

@@ -48,36 +48,110 @@ struct System::Impl {
   std::vector<KeypointDepth> depths;
   cv::Mat gray;
 
+  std::vector<LoopClosure> closures;  // every closure so far (threaded: guarded by loop_mutex)
+
+  // A keyframe on its way through the threads, with its scan for place recognition (the caller's
+  // scan does not outlive track()).
+  struct KeyframeJob {
+    KeyframeId keyframe;
+    std::vector<LidarPoint> scan;
+  };
+
   // Threaded mapping.
   std::thread thread;
   std::mutex queue_mutex;
   std::condition_variable queue_cv, idle_cv;
-  std::deque<KeyframeId> queue;
+  std::deque<KeyframeJob> queue;
   bool busy = false, stop = false;
+
+  // Threaded loop closing (with threaded mapping): keyframes come from the mapping thread once mapped.
+  // Detection runs beside tracking and mapping; a correction holds both gates, so it lands between
+  // two frames and between two keyframes of local mapping, never inside one.
+  std::thread loop_thread;
+  std::mutex loop_mutex;  // guards loop_queue, loop_busy, loop_stop, closures, ready, stats
+  std::condition_variable loop_cv, loop_idle_cv;
+  std::deque<KeyframeJob> loop_queue;
+  bool loop_busy = false, loop_stop = false;
+  std::deque<LoopClosure> ready;  // closed by the loop thread, not yet reported by track()
+  LoopClosingStats stats;         // the loop thread's, after its last keyframe
+  std::mutex mapping_gate;        // held by the mapping thread per keyframe
+  std::mutex tracking_gate;       // held by track() from tracking to the frame's record
 
   Impl(SystemOptions o, CameraCalibration c, std::unique_ptr<DepthSource> d, FeatureExtractor e)
       : options(o), calibration(c), depth(std::move(d)), extractor(std::move(e)), map(o.map),
         tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping), closer(c.camera, o.loop_closing) {
+    if (threaded_loop_closing()) loop_thread = std::thread([this] { run_loop_closing(); });
     if (options.threaded_mapping) thread = std::thread([this] { run_mapping(); });
+  }
+
+  bool threaded_loop_closing() const { return options.threaded_mapping && options.loop_closing.enabled; }
+
+  void queue_for_loop_closing(KeyframeJob job) {
+    {
+      std::lock_guard lock(loop_mutex);
+      loop_queue.push_back(std::move(job));
+    }
+    loop_cv.notify_one();
   }
 
   void run_mapping() {
     for (;;) {
-      KeyframeId next;
+      KeyframeJob next;
       {
         std::unique_lock lock(queue_mutex);
         queue_cv.wait(lock, [&] { return stop || !queue.empty(); });
         if (queue.empty()) return;
-        next = queue.front();
+        next = std::move(queue.front());
         queue.pop_front();
         busy = true;
       }
-      mapper.process(next);
+      {
+        std::lock_guard gate(mapping_gate);
+        mapper.process(next.keyframe);
+      }
+      if (threaded_loop_closing()) queue_for_loop_closing(std::move(next));
       {
         std::lock_guard lock(queue_mutex);
         busy = false;
       }
       idle_cv.notify_all();
+    }
+  }
+
+  void run_loop_closing() {
+    for (;;) {
+      KeyframeJob next;
+      {
+        std::unique_lock lock(loop_mutex);
+        loop_cv.wait(lock, [&] { return loop_stop || !loop_queue.empty(); });
+        if (loop_stop) return;
+        next = std::move(loop_queue.front());
+        loop_queue.pop_front();
+        loop_busy = true;
+      }
+      std::optional<DetectedLoop> loop;
+      LoopCloserStep step = closer.detect(map, next.keyframe, next.scan, loop);
+      if (loop) {
+        std::scoped_lock gates(mapping_gate, tracking_gate);
+        std::optional<Eigen::Isometry3d> T_ref_world_before;
+        {
+          std::unique_lock lock(map.mutex());
+          T_ref_world_before = map.keyframe_pose(tracker.reference_keyframe());
+          closer.correct(map, *loop, step);
+        }
+        // tracking waits at its gate: its last frames follow the reference keyframe here
+        if (step.closure && T_ref_world_before) tracker.follow_map_correction(*T_ref_world_before);
+      }
+      {
+        std::lock_guard lock(loop_mutex);
+        stats = closer.stats();
+        if (step.closure) {
+          closures.push_back(*step.closure);
+          ready.push_back(std::move(*step.closure));
+        }
+        loop_busy = false;
+      }
+      loop_idle_cv.notify_all();
     }
   }
 
@@ -113,15 +187,12 @@ System::System(SystemOptions options, CameraCalibration calibration, std::unique
   calibration.camera.validate();
   if (!depth) throw ConfigError("depth", "a depth source");
   if (!extractor) throw ConfigError("extractor", "a feature extractor");
-  if (options.threaded_mapping && options.loop_closing.enabled) {
-    logger()->warn("loop closing runs inline only for now: off with threaded mapping");
-    options.loop_closing.enabled = false;
-  }
   impl_ = std::make_unique<Impl>(options, calibration, std::move(depth), std::move(extractor));
 }
 
 System::~System() {
-  if (impl_ && impl_->thread.joinable()) {
+  if (!impl_) return;
+  if (impl_->thread.joinable()) {  // first: it feeds the loop thread
     {
       std::lock_guard lock(impl_->queue_mutex);
       impl_->stop = true;
@@ -130,12 +201,25 @@ System::~System() {
     impl_->queue_cv.notify_all();
     impl_->thread.join();
   }
+  if (impl_->loop_thread.joinable()) {
+    {
+      std::lock_guard lock(impl_->loop_mutex);
+      impl_->loop_stop = true;
+    }
+    impl_->loop_cv.notify_all();
+    impl_->loop_thread.join();
+  }
 }
 
 void System::finish() {
   if (!impl_->options.threaded_mapping) return;
-  std::unique_lock lock(impl_->queue_mutex);
-  impl_->idle_cv.wait(lock, [&] { return !impl_->busy && impl_->queue.empty(); });
+  {
+    std::unique_lock lock(impl_->queue_mutex);
+    impl_->idle_cv.wait(lock, [&] { return !impl_->busy && impl_->queue.empty(); });
+  }
+  // mapping has handed over its last keyframe
+  std::unique_lock lock(impl_->loop_mutex);
+  impl_->loop_idle_cv.wait(lock, [&] { return !impl_->loop_busy && impl_->loop_queue.empty(); });
 }
 
 TrackResult System::track(const SensorFrame& sensor) {
@@ -179,16 +263,22 @@ TrackResult System::track(const SensorFrame& sensor) {
   frame.build_grid(s.calibration.camera.width, s.calibration.camera.height);
   result.timing.depth_ms += stage.lap_ms();
 
+  // A loop thread's correction waits for this frame to be tracked and recorded (uncontended inline).
+  const std::lock_guard gate(s.tracking_gate);
   const TrackerOutcome outcome = s.tracker.track(frame, s.mapping_idle());
   KeyframeId new_keyframe;
   if (outcome.need_keyframe) new_keyframe = s.tracker.make_keyframe(frame);
   result.timing.tracking_ms = stage.lap_ms();
 
+  const auto scan_copy = [&] {
+    return s.threaded_loop_closing() ? std::vector<LidarPoint>(sensor.scan.begin(), sensor.scan.end())
+                                     : std::vector<LidarPoint>{};
+  };
   if (new_keyframe.valid()) {
     if (s.options.threaded_mapping) {
       {
         std::lock_guard lock(s.queue_mutex);
-        s.queue.push_back(new_keyframe);
+        s.queue.push_back({new_keyframe, scan_copy()});
       }
       s.queue_cv.notify_one();
     } else {
@@ -199,7 +289,15 @@ TrackResult System::track(const SensorFrame& sensor) {
 
   // The map's first keyframe is a place too (a loop often ends where the drive started).
   const KeyframeId loop_keyframe = outcome.initialised_now ? s.tracker.reference_keyframe() : new_keyframe;
-  if (loop_keyframe.valid() && s.options.loop_closing.enabled) {
+  if (s.threaded_loop_closing()) {
+    // the first keyframe is not mapped: straight to the loop thread; the others come from mapping
+    if (outcome.initialised_now && loop_keyframe.valid()) s.queue_for_loop_closing({loop_keyframe, scan_copy()});
+    std::lock_guard lock(s.loop_mutex);
+    if (!s.ready.empty()) {
+      result.loop_closure = std::move(s.ready.front());
+      s.ready.pop_front();
+    }
+  } else if (loop_keyframe.valid() && s.options.loop_closing.enabled) {
     std::optional<Eigen::Isometry3d> T_ref_world_before;
     {
       std::shared_lock lock(s.map.mutex());
@@ -210,6 +308,7 @@ TrackResult System::track(const SensorFrame& sensor) {
       // this frame is the reference keyframe: it moves with it, as the tracker's last frames do
       if (const auto moved = s.tracker.follow_map_correction(*T_ref_world_before)) frame.T_cam_world = frame.T_cam_world * *moved;
     }
+    if (step.closure) s.closures.push_back(*step.closure);
     result.loop_closure = std::move(step.closure);
   }
   result.timing.loop_ms = stage.lap_ms();
@@ -268,6 +367,16 @@ const Map& System::map() const { return impl_->map; }
 const CameraCalibration& System::calibration() const { return impl_->calibration; }
 bool System::loop_closing() const { return impl_->options.loop_closing.enabled; }
 
-LoopClosingStats System::loop_statistics() const { return impl_->closer.stats(); }
+LoopClosingStats System::loop_statistics() const {
+  if (!impl_->threaded_loop_closing()) return impl_->closer.stats();
+  std::lock_guard lock(impl_->loop_mutex);
+  return impl_->stats;
+}
+
+std::vector<LoopClosure> System::loop_closures() const {
+  if (!impl_->threaded_loop_closing()) return impl_->closures;
+  std::lock_guard lock(impl_->loop_mutex);
+  return impl_->closures;
+}
 
 }  // namespace rgbl

@@ -25,10 +25,10 @@ struct SystemOptions {
   LocalMappingOptions mapping;
   DepthNoiseModel depth_noise;
   MapOptions map;
-  // Loop closing after local mapping on every keyframe with a LiDAR scan (inline only for now: with
-  // threaded_mapping it is off, and a warning says so).
+  // Loop closing after local mapping on every keyframe.
   LoopClosingOptions loop_closing;
-  // false: local mapping runs inside track() and the same input gives a bit-identical trajectory.
+  // false: local mapping and loop closing run inside track() and the same input gives a bit-identical
+  // trajectory. true: local mapping in a thread of its own, and loop closing in another.
   bool threaded_mapping = false;
   // Motion compensation of LiDAR depth: a spinning LiDAR measures a point at azimuth a (0 = ahead,
   // positive to the left) at a time offset of -spin * a / (2 pi) * scan_period from the camera
@@ -65,7 +65,9 @@ struct TrackResult {
   bool step_rejected = false;  // a step beyond a vehicle's reach on weak evidence: weak, at the prediction
   int inliers = 0;           // local-map inliers (ok needs 30, 50 after a relocalisation)
   int keypoints = 0, keypoints_with_depth = 0;
-  std::optional<LoopClosure> loop_closure;  // a loop closed on this frame: the map was corrected
+  // A loop closed: inline, on this frame (a keyframe); threaded, by the loop thread since the last
+  // frame (its frame_index says which keyframe closed it). The map was corrected.
+  std::optional<LoopClosure> loop_closure;
   StageTiming timing;
 };
 
@@ -88,7 +90,8 @@ class System {
   // source); a frame without depth (e.g. a dropped LiDAR scan) is tracked on the map alone.
   TrackResult track(const SensorFrame& frame);
 
-  // Waits until threaded mapping has processed every queued keyframe (no-op when inline).
+  // Waits until threaded mapping and loop closing have processed every queued keyframe (no-op when
+  // inline); the trajectory then includes every correction.
   void finish();
 
   // Every frame so far, with poses refined by mapping (frames are stored relative to their reference
@@ -98,10 +101,13 @@ class System {
   // Lock map().mutex() (shared) to read while threaded mapping runs.
   const Map& map() const;
   const CameraCalibration& calibration() const;
-  // Loops are closed: enabled in the options and mapping inline.
+  // Loops are closed (inline, or with threaded mapping in a thread of its own).
   bool loop_closing() const;
   // What the loop closer considered so far (all zero without loop closing).
   LoopClosingStats loop_statistics() const;
+  // Every closure so far, in order. In a thread of its own a closure is also reported in the
+  // TrackResult of the first frame tracked after it; after finish() this holds them all.
+  std::vector<LoopClosure> loop_closures() const;
 
  struct Impl;  // public name only so that helpers in the .cpp can take it
 
