@@ -309,12 +309,12 @@ RunOutcome run_pipeline(Pipeline& p, const std::filesystem::path& out_dir, bool 
         "{}\n    {{\"frame\": {}, \"matched_frame\": {}, \"merge\": {}, \"place\": \"{}\", \"place_similarity\": {}, "
         "\"inliers\": {}, "
         "\"correction_m\": {}, \"correction_deg\": {}, \"loop_error_before_m\": {}, \"loop_error_after_m\": {}, "
-        "\"fused_landmarks\": {}, \"global_ba\": {{\"keyframes\": {}, \"landmarks\": {}, \"outliers\": {}, "
+        "\"fused_landmarks\": {}, \"global_ba\": {{\"keyframes\": {}, \"held\": {}, \"landmarks\": {}, \"outliers\": {}, "
         "\"time_ms\": {}}}, \"time_ms\": {}}}",
         loop_closures.empty() ? "" : ",", c.frame_index, c.matched_frame_index, c.merged ? "true" : "false",
         c.place_source, json_number(c.place_similarity), c.inliers,
         json_number(c.correction_m), json_number(c.correction_deg), json_number(c.correction.loop_error_before_m),
-        json_number(c.correction.loop_error_after_m), c.fused_landmarks, c.global_ba_keyframes, c.global_ba_landmarks,
+        json_number(c.correction.loop_error_after_m), c.fused_landmarks, c.global_ba_keyframes, c.global_ba_held, c.global_ba_landmarks,
         c.global_ba_outliers, json_number(c.global_ba_ms), json_number(c.time_ms));
   }
   if (!loop_closures.empty()) loop_closures += "\n  ";

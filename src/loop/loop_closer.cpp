@@ -39,6 +39,7 @@ void LoopClosingOptions::validate() const {
   require(fusion_neighbours >= 0, "loop_closing.fusion_neighbours", ">= 0 keyframes");
   fusion.validate();
   global_ba_options.validate();
+  require(global_ba_min_shared >= 0, "loop_closing.global_ba_min_shared", ">= 0 observations");
 }
 
 namespace {
@@ -207,10 +208,46 @@ void LoopCloser::adjust_map(Map& map, KeyframeId keyframe, LoopClosure& closure)
   std::vector<KeyframeId> tree = map.keyframe_ids();
   std::erase_if(tree, [&](KeyframeId k) { return roots(k) != root; });
   MapBundle bundle = make_map_bundle(map, tree, {}, root);
+  // A keyframe whose landmarks have mostly been culled or fused away is barely determined by the
+  // landmarks it shares (2 observations can leave it free to slide metres at almost no cost: one lap of
+  // 79 m, seed 3, keyframe of frame 18 moved 13.5 m). It is held during the solve and then moved
+  // rigidly with its parent, as the pose graph moved it.
+  std::vector<int> seen(bundle.problem.points.size(), 0);
+  for (const BundleObservation& o : bundle.problem.observations) ++seen[static_cast<std::size_t>(o.point)];
+  std::vector<int> shared(bundle.problem.poses.size(), 0);
+  for (const BundleObservation& o : bundle.problem.observations) {
+    if (seen[static_cast<std::size_t>(o.point)] > 1) ++shared[static_cast<std::size_t>(o.pose)];
+  }
+  std::vector<std::pair<KeyframeId, Eigen::Isometry3d>> held;  // with T_cam_parent before
+  for (std::size_t i = 0; i < bundle.keyframes.size(); ++i) {
+    if (bundle.problem.poses[i].fixed || shared[i] >= options_.global_ba_min_shared) continue;
+    const Keyframe* kf = map.keyframe(bundle.keyframes[i]);
+    const auto T_parent_world = map.keyframe_pose(kf->parent);
+    if (!T_parent_world) continue;
+    bundle.problem.poses[i].fixed = true;
+    held.emplace_back(kf->id, kf->T_cam_world * T_parent_world->inverse());
+  }
   const BundleAdjustmentResult result = bundle_adjust(camera_, bundle.problem, options_.global_ba_options);
   closure.global_ba_keyframes = static_cast<int>(bundle.keyframes.size());
   closure.global_ba_landmarks = static_cast<int>(bundle.landmarks.size());
+  closure.global_ba_held = static_cast<int>(held.size());
   closure.global_ba_outliers = apply_map_bundle(map, bundle, result);
+  // parents are older: in id order each parent is placed before its children
+  std::sort(held.begin(), held.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [k, T_cam_parent] : held) {
+    Keyframe& kf = *map.keyframe(k);
+    const Eigen::Isometry3d T_cam_world_before = kf.T_cam_world;
+    kf.T_cam_world = T_cam_parent * *map.keyframe_pose(kf.parent);
+    // what only this keyframe sees moves with it
+    const Eigen::Isometry3d T_new_old = kf.T_cam_world.inverse() * T_cam_world_before;
+    for (const LandmarkId l : kf.landmarks) {
+      Landmark* landmark = l.valid() ? map.landmark(l) : nullptr;
+      if (landmark != nullptr && landmark->observations.size() == 1) landmark->position = T_new_old * landmark->position;
+    }
+  }
+  if (!held.empty()) {
+    for (const LandmarkId l : map.landmarks_seen_by(tree)) map.update_landmark(l);
+  }
   closure.global_ba_ms = watch.elapsed_ms();
 }
 

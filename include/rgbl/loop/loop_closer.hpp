@@ -91,6 +91,10 @@ struct LoopClosingOptions {
   // Bundle adjustment of the whole map after a closure (its spanning-tree root held fixed).
   bool global_ba = false;
   BundleAdjustmentOptions global_ba_options = {.iterations = 10, .dense_schur = false};
+  // A keyframe takes part in it only with at least this many observations of landmarks that other
+  // keyframes see too (the evidence the tracker asks of a frame to call it ok); one with fewer is
+  // held and then moved rigidly with its spanning-tree parent.
+  int global_ba_min_shared = 30;
 
   void validate() const;
 };
@@ -111,6 +115,7 @@ struct LoopClosure {
   int fused_landmarks = 0;              // duplicates across the loop made one, observations added
   int global_ba_keyframes = 0;          // keyframes and landmarks in the global bundle adjustment
   int global_ba_landmarks = 0;
+  int global_ba_held = 0;               // of those keyframes, held for too little shared evidence
   int global_ba_outliers = 0;           // observations it erased
   double global_ba_ms = 0.0;
 };
