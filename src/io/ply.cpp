@@ -3,6 +3,8 @@
 #include "rgbl/core/error.hpp"
 #include "text.hpp"
 
+#include "rgbl/core/file.hpp"
+
 #include <fmt/format.h>
 
 #include <string>
@@ -24,7 +26,7 @@ void write_ply(const std::filesystem::path& file, std::span<const Eigen::Vector3
   const double s = options.camera_size;
   const Eigen::Vector3d corners[4] = {{-s / 2, -s / 3, s}, {s / 2, -s / 3, s}, {s / 2, s / 3, s}, {-s / 2, s / 3, s}};
   const std::size_t vertex_count = points.size() + 5 * T_world_cams.size();
-  detail::write_atomically(file, [&](std::ofstream& out) {
+  write_atomically(file, [&](std::ofstream& out) {
     out << "ply\nformat ascii 1.0\ncomment rgbl map: points then camera pyramids\n";
     out << fmt::format("element vertex {}\n", vertex_count);
     out << "property double x\nproperty double y\nproperty double z\n";

@@ -1,5 +1,7 @@
 #include "rgbl/io/settings.hpp"
 
+#include "text.hpp"
+
 #include "rgbl/core/error.hpp"
 
 #include <fmt/format.h>
@@ -286,18 +288,12 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.loop_closing.enabled = flag("LoopClosing.Enabled");
   s.loop_closing.max_place_distance = r.number({"LoopClosing.MaxPlaceDistance"});
   if (const auto v = r.string({"LoopClosing.Places"})) {
-    std::vector<std::string> methods;
-    std::string name;
-    for (const char c : *v + ",") {
-      if (c == ',') {
-        if (name.empty()) r.fail("LoopClosing.Places", "place recogniser names separated by commas, e.g. \"scan_context,bow\"");
-        methods.push_back(name);
-        name.clear();
-      } else if (c != ' ') {
-        name += c;
-      }
+    const std::vector<std::string_view> methods = detail::split(*v);
+    // one name per comma-separated field: no empty field, no two names in one
+    if (methods.empty() || std::cmp_not_equal(std::count(v->begin(), v->end(), ',') + 1, methods.size())) {
+      r.fail("LoopClosing.Places", "place recogniser names separated by commas, e.g. \"scan_context,bow\"");
     }
-    s.loop_closing.places = methods;
+    s.loop_closing.places = std::vector<std::string>(methods.begin(), methods.end());
   }
   if (const auto v = r.string({"LoopClosing.Vocabulary"})) {
     if (v->empty()) r.fail("LoopClosing.Vocabulary", "a vocabulary file (written by `rgbl vocab train`)");

@@ -71,29 +71,6 @@ void for_each_record(const std::filesystem::path& file, std::string_view what, s
   }
 }
 
-void write_atomically(const std::filesystem::path& file, const std::function<void(std::ofstream&)>& write) {
-  auto tmp = file;
-  tmp += ".part";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(fmt::format("{}: cannot open for writing", file.string()));
-    write(out);
-    out.flush();
-    if (!out) {
-      out.close();
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw Error(fmt::format("{}: write failed (disk full?)", file.string()));
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw Error(fmt::format("{}: cannot move the finished file into place", file.string()));
-  }
-}
-
 std::vector<std::size_t> numbered_files(const std::filesystem::path& dir, std::string_view extension) {
   std::vector<std::size_t> indices;
   std::error_code ec;

@@ -29,10 +29,6 @@ void for_each_record(const std::filesystem::path& file, std::string_view what, s
                      std::string_view record,
                      const std::function<void(std::size_t line_no, std::span<const double> numbers)>& on_record);
 
-// Calls write(stream) on a temporary file next to `file`, then renames it into place; on failure
-// removes the temporary and throws Error naming `file`.
-void write_atomically(const std::filesystem::path& file, const std::function<void(std::ofstream&)>& write);
-
 // Sorted indices of files named <digits><extension> in `dir`, keyed by their number.
 std::vector<std::size_t> numbered_files(const std::filesystem::path& dir, std::string_view extension);
 

@@ -3,6 +3,8 @@
 #include "rgbl/core/error.hpp"
 #include "text.hpp"
 
+#include "rgbl/core/file.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -21,7 +23,7 @@ bool is_rotation(const Eigen::Matrix3d& R) {
 }  // namespace
 
 void write_kitti_trajectory(const std::filesystem::path& file, std::span<const Eigen::Isometry3d> poses) {
-  detail::write_atomically(file, [&](std::ofstream& out) {
+  write_atomically(file, [&](std::ofstream& out) {
     std::string line;
     for (const auto& T : poses) {
       line.clear();
@@ -56,7 +58,7 @@ void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& t
     throw Error(fmt::format("{}: {} timestamps for {} poses", file.string(), trajectory.timestamps.size(),
                             trajectory.poses.size()));
   }
-  detail::write_atomically(file, [&](std::ofstream& out) {
+  write_atomically(file, [&](std::ofstream& out) {
     out << "# timestamp tx ty tz qx qy qz qw\n";
     for (std::size_t i = 0; i < trajectory.size(); ++i) {
       const auto& T = trajectory.poses[i];

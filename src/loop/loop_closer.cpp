@@ -74,11 +74,6 @@ class Roots {
   std::unordered_map<int, KeyframeId> known_;
 };
 
-struct Verified {
-  LoopVerification verification;
-  PlaceCandidate place;
-};
-
 // How far camera pose b is from a: centre distance and rotation angle.
 struct PoseChange {
   double m = 0.0, deg = 0.0;
@@ -104,7 +99,7 @@ bool plausible_drift(const LoopClosingOptions& o, PoseChange asked, double drive
 // pair that does not see the place is skipped; one that sees it and disagrees refuses the loop. The
 // loop constraints of the consistent_keyframes - 1 pairs that confirmed, or nullopt.
 std::optional<std::vector<LoopConstraint>> confirm(const PinholeCamera& camera, const LoopClosingOptions& options,
-                                                   const Map& map, const Keyframe& current, const Verified& loop,
+                                                   const Map& map, const Keyframe& current, const DetectedLoop& loop,
                                                    std::span<const KeyframeId> previous) {
   const Eigen::Isometry3d& T_cur_world_loop = loop.verification.T_cam_world;
   const KeyframeId matched = loop.verification.constraint.matched;
@@ -209,9 +204,9 @@ void LoopCloser::adjust_map(Map& map, KeyframeId keyframe, LoopClosure& closure)
   std::erase_if(tree, [&](KeyframeId k) { return roots(k) != root; });
   MapBundle bundle = make_map_bundle(map, tree, {}, root);
   // A keyframe whose landmarks have mostly been culled or fused away is barely determined by the
-  // landmarks it shares (2 observations can leave it free to slide metres at almost no cost: one lap of
-  // 79 m, seed 3, keyframe of frame 18 moved 13.5 m). It is held during the solve and then moved
-  // rigidly with its parent, as the pose graph moved it.
+  // landmarks it shares: 2 observations left it free to slide metres at almost no cost (two laps of
+  // 79.5 m, seed 3, first closure: 13.5 m with 50 iterations; docs/loop-closing.md). It is held during
+  // the solve and then moved rigidly with its parent, as the pose graph moved it.
   std::vector<int> seen(bundle.problem.points.size(), 0);
   for (const BundleObservation& o : bundle.problem.observations) ++seen[static_cast<std::size_t>(o.point)];
   std::vector<int> shared(bundle.problem.poses.size(), 0);
@@ -286,8 +281,7 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
     return step;
   };
   ++stats_.keyframes;
-  std::optional<Verified> best;
-  std::vector<LoopConstraint> confirmed;  // the earlier keyframes' verifications of the same loop
+  std::optional<DetectedLoop> best;  // the verified candidate with the most inliers
   KeyframeId root;  // of the current keyframe's map
   {
     std::shared_lock lock(map.mutex());
@@ -344,7 +338,7 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
         continue;
       }
       if (!best || verified->counts.inliers > best->verification.counts.inliers) {
-        best = Verified{std::move(*verified), place};
+        best = DetectedLoop{keyframe, std::move(*verified), place, {}};
       }
     }
     if (best) {
@@ -355,7 +349,7 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
       }
       if (auto constraints = confirm(camera_, options_, map, *current, *best, previous)) {
         step.consistent = true;
-        confirmed = std::move(*constraints);
+        best->confirmations = std::move(*constraints);
       }
     }
     for (const auto& recognizer : places_) recognizer->add(query);  // under the lock: reads the descriptors
@@ -366,21 +360,26 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
   stats_.implausible += step.implausible;
   if (!step.consistent) return done();
   ++stats_.consistent;
-  loop = DetectedLoop{keyframe, best->verification, best->place, std::move(confirmed)};
+  loop = std::move(best);
   return done();
 }
 
 void LoopCloser::correct(Map& map, const DetectedLoop& loop, LoopCloserStep& step) {
   const Stopwatch watch;
-  struct AddTime {  // on every return
-    LoopCloserStep& step;
-    double& total_ms;
-    const Stopwatch& watch;
-    ~AddTime() {
-      step.time_ms += watch.elapsed_ms();
-      total_ms += watch.elapsed_ms();
-    }
-  } add_time{step, stats_.time_ms, watch};
+  apply(map, loop, step);
+  step.time_ms += watch.elapsed_ms();
+  stats_.time_ms += watch.elapsed_ms();
+  if (!step.closure) return;
+  LoopClosure& c = *step.closure;
+  c.time_ms = step.time_ms;  // detection and correction
+  logger()->info("{}: frame {} with frame {} ({} {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
+                 "loop error {:.2f} -> {:.3f} m, {} landmarks fused, global BA {} keyframes {:.0f} ms, {:.0f} ms",
+                 c.merged ? "maps merged" : "loop closed", c.frame_index, c.matched_frame_index, c.place_source,
+                 c.place_similarity, c.inliers, c.correction_m, c.correction_deg, c.correction.loop_error_before_m,
+                 c.correction.loop_error_after_m, c.fused_landmarks, c.global_ba_keyframes, c.global_ba_ms, c.time_ms);
+}
+
+void LoopCloser::apply(Map& map, const DetectedLoop& loop, LoopCloserStep& step) {
   const KeyframeId keyframe = loop.keyframe;
   const KeyframeId matched = loop.verification.constraint.matched;
   // In a thread of its own, mapping may have culled either side since detection.
@@ -429,14 +428,7 @@ void LoopCloser::correct(Map& map, const DetectedLoop& loop, LoopCloserStep& ste
   last_centre_ = map.keyframe(keyframe)->center();  // odometry goes on from the corrected map
   closure.correction_m = moved.m;
   closure.correction_deg = moved.deg;
-  closure.time_ms = step.time_ms + watch.elapsed_ms();  // detection and correction
-  logger()->info("{}: frame {} with frame {} ({} {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
-                 "loop error {:.2f} -> {:.3f} m, {} landmarks fused, global BA {} keyframes {:.0f} ms, {:.0f} ms",
-                 closure.merged ? "maps merged" : "loop closed", closure.frame_index, closure.matched_frame_index,
-                 closure.place_source, closure.place_similarity, closure.inliers, closure.correction_m, closure.correction_deg,
-                 closure.correction.loop_error_before_m, closure.correction.loop_error_after_m, closure.fused_landmarks, closure.global_ba_keyframes,
-                 closure.global_ba_ms, closure.time_ms);
-  step.closure = closure;
+  step.closure = std::move(closure);
 }
 
 }  // namespace rgbl

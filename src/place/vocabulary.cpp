@@ -1,6 +1,7 @@
 #include "rgbl/place/vocabulary.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 
 #include <fmt/format.h>
 
@@ -8,7 +9,6 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <deque>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -59,6 +59,21 @@ Descriptor majority(const std::vector<Descriptor>& all, std::span<const std::uin
   return centre;
 }
 
+// Index in [0, count) of the centre nearest to d by Hamming distance (ties: the first).
+template <class Centre>
+std::size_t nearest_centre(const Descriptor& d, std::size_t count, Centre centre) {
+  std::size_t best = 0;
+  int best_distance = std::numeric_limits<int>::max();
+  for (std::size_t c = 0; c < count; ++c) {
+    const int distance = hamming_distance(d, centre(c));
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = c;
+    }
+  }
+  return best;
+}
+
 // Uniform in [0, 1) from 53 bits: the same on every platform (std::uniform_real_distribution is not).
 double uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
@@ -94,16 +109,8 @@ std::vector<std::vector<std::uint32_t>> cluster(const std::vector<Descriptor>& a
   for (int round = 0; round < iterations; ++round) {
     std::vector<std::vector<std::uint32_t>> assigned(centres.size());
     for (const std::uint32_t m : members) {
-      std::size_t best = 0;
-      int best_distance = std::numeric_limits<int>::max();
-      for (std::size_t c = 0; c < centres.size(); ++c) {
-        const int d = hamming_distance(all[m], centres[c]);
-        if (d < best_distance) {
-          best_distance = d;
-          best = c;
-        }
-      }
-      assigned[best].push_back(m);
+      assigned[nearest_centre(all[m], centres.size(), [&](std::size_t c) -> const Descriptor& { return centres[c]; })]
+          .push_back(m);
     }
     std::erase_if(assigned, [](const auto& c) { return c.empty(); });
     if (assigned == clusters) break;  // converged
@@ -175,41 +182,26 @@ Vocabulary Vocabulary::train(std::span<const std::vector<Descriptor>> images, co
     members[n].shrink_to_fit();
   }
   // Words are the leaves in node order; weight = log(N / images holding the word).
-  std::vector<std::uint32_t> last_image;  // per word, to count each image once
-  std::vector<std::uint32_t> holding;
   for (std::size_t n = 0; n < v.nodes_.size(); ++n) {
     if (v.nodes_[n].children != 0) continue;
     v.nodes_[n].word = static_cast<std::uint32_t>(v.leaves_.size());
     v.leaves_.push_back(static_cast<std::uint32_t>(n));
-    std::uint32_t count = 0;
-    std::uint32_t previous = std::numeric_limits<std::uint32_t>::max();
-    std::vector<std::uint32_t> seen;
-    for (const std::uint32_t m : members[n]) seen.push_back(image_of[m]);
-    std::sort(seen.begin(), seen.end());
-    for (const std::uint32_t image : seen) {
-      if (image != previous) ++count;
-      previous = image;
-    }
-    v.nodes_[n].weight = static_cast<float>(std::log(static_cast<double>(images.size()) / std::max<std::uint32_t>(count, 1)));
+    std::vector<std::uint32_t> holding;  // images, each once
+    for (const std::uint32_t m : members[n]) holding.push_back(image_of[m]);
+    std::sort(holding.begin(), holding.end());
+    const auto count = std::distance(holding.begin(), std::unique(holding.begin(), holding.end()));
+    v.nodes_[n].weight = static_cast<float>(std::log(static_cast<double>(images.size()) / std::max<std::ptrdiff_t>(count, 1)));
   }
-  v.words_ = v.leaves_.size();
   return v;
 }
 
 std::uint32_t Vocabulary::word(const Descriptor& descriptor) const {
   std::uint32_t n = 0;
   while (nodes_[n].children != 0) {
-    const Node& node = nodes_[n];
-    std::uint32_t best = node.first_child;
-    int best_distance = std::numeric_limits<int>::max();
-    for (std::uint32_t c = node.first_child; c < node.first_child + node.children; ++c) {
-      const int d = hamming_distance(descriptor, nodes_[c].centre);
-      if (d < best_distance) {
-        best_distance = d;
-        best = c;
-      }
-    }
-    n = best;
+    const std::uint32_t first = nodes_[n].first_child;
+    n = first + static_cast<std::uint32_t>(nearest_centre(descriptor, nodes_[n].children, [&](std::size_t c) -> const Descriptor& {
+          return nodes_[first + c].centre;
+        }));
   }
   return nodes_[n].word;
 }
@@ -244,7 +236,7 @@ std::vector<std::uint8_t> Vocabulary::to_bytes() const {
   put_u32(out, static_cast<std::uint32_t>(branching_));
   put_u32(out, static_cast<std::uint32_t>(levels_));
   put_u32(out, static_cast<std::uint32_t>(nodes_.size()));
-  put_u32(out, static_cast<std::uint32_t>(words_));
+  put_u32(out, static_cast<std::uint32_t>(leaves_.size()));
   out.reserve(out.size() + nodes_.size() * kNodeBytes + 8);
   for (const Node& n : nodes_) {
     out.insert(out.end(), n.centre.begin(), n.centre.end());
@@ -323,7 +315,6 @@ Vocabulary Vocabulary::from_bytes(std::span<const std::uint8_t> bytes, const std
     for (std::uint32_t c = 0; c < v.nodes_[n].children; ++c) depth[v.nodes_[n].first_child + c] = depth[n] + 1;
     if (depth[n] > levels) fail(fmt::format("node {} at depth {} of {} levels", n, depth[n], levels));
   }
-  v.words_ = words;
   return v;
 }
 
@@ -341,10 +332,9 @@ Vocabulary Vocabulary::load(const std::filesystem::path& file) {
 
 void Vocabulary::save(const std::filesystem::path& file) const {
   const std::vector<std::uint8_t> bytes = to_bytes();
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  out.close();
-  if (!out) throw ParseError(file, 0, "cannot be written (for a vocabulary)");
+  write_atomically(file, [&](std::ofstream& out) {
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  });
 }
 
 }  // namespace rgbl

@@ -11,6 +11,7 @@
 #include <condition_variable>
 #include <deque>
 #include <mutex>
+#include <optional>
 #include <shared_mutex>
 #include <thread>
 
@@ -32,6 +33,59 @@ struct FrameRecord {
   KeyframeId reference;
   Eigen::Isometry3d T_cam_reference = Eigen::Isometry3d::Identity();
 };
+
+// Jobs for one worker thread, taken one at a time; idle = nothing queued and nothing in hand.
+template <class Job>
+class WorkQueue {
+ public:
+  void push(Job job) {
+    {
+      std::lock_guard lock(mutex_);
+      jobs_.push_back(std::move(job));
+    }
+    wake_.notify_one();
+  }
+  // The next job (the worker is busy with it until done()), waiting for one; nullopt once stopped,
+  // after the queued jobs when `drain`.
+  std::optional<Job> pop(bool drain) {
+    std::unique_lock lock(mutex_);
+    wake_.wait(lock, [&] { return stop_ || !jobs_.empty(); });
+    if (stop_ && (!drain || jobs_.empty())) return std::nullopt;
+    Job job = std::move(jobs_.front());
+    jobs_.pop_front();
+    busy_ = true;
+    return job;
+  }
+  void done() {
+    {
+      std::lock_guard lock(mutex_);
+      busy_ = false;
+    }
+    idle_.notify_all();
+  }
+  bool idle() const {
+    std::lock_guard lock(mutex_);
+    return !busy_ && jobs_.empty();
+  }
+  void wait_idle() {
+    std::unique_lock lock(mutex_);
+    idle_.wait(lock, [&] { return !busy_ && jobs_.empty(); });
+  }
+  void stop() {
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::condition_variable wake_, idle_;
+  std::deque<Job> jobs_;
+  bool busy_ = false, stop_ = false;
+};
+
 }  // namespace
 
 struct System::Impl {
@@ -48,7 +102,7 @@ struct System::Impl {
   std::vector<KeypointDepth> depths;
   cv::Mat gray;
 
-  std::vector<LoopClosure> closures;  // every closure so far (threaded: guarded by loop_mutex)
+  std::vector<LoopClosure> closures;  // every closure so far (threaded: guarded by results_mutex)
 
   // A keyframe on its way through the threads, with its scan for place recognition (the caller's
   // scan does not outlive track()).
@@ -57,80 +111,42 @@ struct System::Impl {
     std::vector<LidarPoint> scan;
   };
 
-  // Threaded mapping.
-  std::thread thread;
-  std::mutex queue_mutex;
-  std::condition_variable queue_cv, idle_cv;
-  std::deque<KeyframeJob> queue;
-  bool busy = false, stop = false;
-
-  // Threaded loop closing (with threaded mapping): keyframes come from the mapping thread once mapped.
+  // Threaded mapping, and loop closing (with threaded mapping) fed by it once a keyframe is mapped.
   // Detection runs beside tracking and mapping; a correction holds both gates, so it lands between
   // two frames and between two keyframes of local mapping, never inside one.
-  std::thread loop_thread;
-  std::mutex loop_mutex;  // guards loop_queue, loop_busy, loop_stop, closures, ready, stats
-  std::condition_variable loop_cv, loop_idle_cv;
-  std::deque<KeyframeJob> loop_queue;
-  bool loop_busy = false, loop_stop = false;
-  std::deque<LoopClosure> ready;  // closed by the loop thread, not yet reported by track()
-  LoopClosingStats stats;         // the loop thread's, after its last keyframe
-  std::mutex mapping_gate;        // held by the mapping thread per keyframe
-  std::mutex tracking_gate;       // held by track() from tracking to the frame's record
+  WorkQueue<KeyframeJob> mapping_queue, loop_queue;
+  std::thread mapping_thread, loop_thread;
+  std::mutex mapping_gate;   // held by the mapping thread per keyframe
+  std::mutex tracking_gate;  // held by track() from tracking to the frame's record
+  mutable std::mutex results_mutex;  // guards closures, reported, stats while the loop thread runs
+  std::size_t reported = 0;          // closures already handed to a TrackResult
+  LoopClosingStats stats;            // the loop thread's, after its last keyframe
 
   Impl(SystemOptions o, CameraCalibration c, std::unique_ptr<DepthSource> d, FeatureExtractor e)
       : options(o), calibration(c), depth(std::move(d)), extractor(std::move(e)), map(o.map),
         tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping), closer(c.camera, o.loop_closing) {
     if (threaded_loop_closing()) loop_thread = std::thread([this] { run_loop_closing(); });
-    if (options.threaded_mapping) thread = std::thread([this] { run_mapping(); });
+    if (options.threaded_mapping) mapping_thread = std::thread([this] { run_mapping(); });
   }
 
   bool threaded_loop_closing() const { return options.threaded_mapping && options.loop_closing.enabled; }
 
-  void queue_for_loop_closing(KeyframeJob job) {
-    {
-      std::lock_guard lock(loop_mutex);
-      loop_queue.push_back(std::move(job));
-    }
-    loop_cv.notify_one();
-  }
-
   void run_mapping() {
-    for (;;) {
-      KeyframeJob next;
-      {
-        std::unique_lock lock(queue_mutex);
-        queue_cv.wait(lock, [&] { return stop || !queue.empty(); });
-        if (queue.empty()) return;
-        next = std::move(queue.front());
-        queue.pop_front();
-        busy = true;
-      }
+    // drains the queue when stopped (local mapping aborts its bundle adjustment to be quick)
+    while (std::optional<KeyframeJob> next = mapping_queue.pop(/*drain=*/true)) {
       {
         std::lock_guard gate(mapping_gate);
-        mapper.process(next.keyframe);
+        mapper.process(next->keyframe);
       }
-      if (threaded_loop_closing()) queue_for_loop_closing(std::move(next));
-      {
-        std::lock_guard lock(queue_mutex);
-        busy = false;
-      }
-      idle_cv.notify_all();
+      if (threaded_loop_closing()) loop_queue.push(std::move(*next));  // before done(): finish() sees it
+      mapping_queue.done();
     }
   }
 
   void run_loop_closing() {
-    for (;;) {
-      KeyframeJob next;
-      {
-        std::unique_lock lock(loop_mutex);
-        loop_cv.wait(lock, [&] { return loop_stop || !loop_queue.empty(); });
-        if (loop_stop) return;
-        next = std::move(loop_queue.front());
-        loop_queue.pop_front();
-        loop_busy = true;
-      }
+    while (std::optional<KeyframeJob> next = loop_queue.pop(/*drain=*/false)) {
       std::optional<DetectedLoop> loop;
-      LoopCloserStep step = closer.detect(map, next.keyframe, next.scan, loop);
+      LoopCloserStep step = closer.detect(map, next->keyframe, next->scan, loop);
       if (loop) {
         std::scoped_lock gates(mapping_gate, tracking_gate);
         std::optional<Eigen::Isometry3d> T_ref_world_before;
@@ -143,23 +159,15 @@ struct System::Impl {
         if (step.closure && T_ref_world_before) tracker.follow_map_correction(*T_ref_world_before);
       }
       {
-        std::lock_guard lock(loop_mutex);
+        std::lock_guard lock(results_mutex);
         stats = closer.stats();
-        if (step.closure) {
-          closures.push_back(*step.closure);
-          ready.push_back(std::move(*step.closure));
-        }
-        loop_busy = false;
+        if (step.closure) closures.push_back(std::move(*step.closure));
       }
-      loop_idle_cv.notify_all();
+      loop_queue.done();
     }
   }
 
-  bool mapping_idle() {
-    if (!options.threaded_mapping) return true;
-    std::lock_guard lock(queue_mutex);
-    return !busy && queue.empty();
-  }
+  bool mapping_idle() const { return !options.threaded_mapping || mapping_queue.idle(); }
 };
 
 namespace {
@@ -192,34 +200,21 @@ System::System(SystemOptions options, CameraCalibration calibration, std::unique
 
 System::~System() {
   if (!impl_) return;
-  if (impl_->thread.joinable()) {  // first: it feeds the loop thread
-    {
-      std::lock_guard lock(impl_->queue_mutex);
-      impl_->stop = true;
-    }
+  if (impl_->mapping_thread.joinable()) {  // first: it feeds the loop thread
+    impl_->mapping_queue.stop();
     impl_->mapper.request_abort();
-    impl_->queue_cv.notify_all();
-    impl_->thread.join();
+    impl_->mapping_thread.join();
   }
   if (impl_->loop_thread.joinable()) {
-    {
-      std::lock_guard lock(impl_->loop_mutex);
-      impl_->loop_stop = true;
-    }
-    impl_->loop_cv.notify_all();
+    impl_->loop_queue.stop();
     impl_->loop_thread.join();
   }
 }
 
 void System::finish() {
   if (!impl_->options.threaded_mapping) return;
-  {
-    std::unique_lock lock(impl_->queue_mutex);
-    impl_->idle_cv.wait(lock, [&] { return !impl_->busy && impl_->queue.empty(); });
-  }
-  // mapping has handed over its last keyframe
-  std::unique_lock lock(impl_->loop_mutex);
-  impl_->loop_idle_cv.wait(lock, [&] { return !impl_->loop_busy && impl_->loop_queue.empty(); });
+  impl_->mapping_queue.wait_idle();
+  impl_->loop_queue.wait_idle();  // mapping has handed over its last keyframe
 }
 
 TrackResult System::track(const SensorFrame& sensor) {
@@ -276,11 +271,7 @@ TrackResult System::track(const SensorFrame& sensor) {
   };
   if (new_keyframe.valid()) {
     if (s.options.threaded_mapping) {
-      {
-        std::lock_guard lock(s.queue_mutex);
-        s.queue.push_back({new_keyframe, scan_copy()});
-      }
-      s.queue_cv.notify_one();
+      s.mapping_queue.push({new_keyframe, scan_copy()});
     } else {
       s.mapper.process(new_keyframe);
     }
@@ -291,12 +282,9 @@ TrackResult System::track(const SensorFrame& sensor) {
   const KeyframeId loop_keyframe = outcome.initialised_now ? s.tracker.reference_keyframe() : new_keyframe;
   if (s.threaded_loop_closing()) {
     // the first keyframe is not mapped: straight to the loop thread; the others come from mapping
-    if (outcome.initialised_now && loop_keyframe.valid()) s.queue_for_loop_closing({loop_keyframe, scan_copy()});
-    std::lock_guard lock(s.loop_mutex);
-    if (!s.ready.empty()) {
-      result.loop_closure = std::move(s.ready.front());
-      s.ready.pop_front();
-    }
+    if (outcome.initialised_now && loop_keyframe.valid()) s.loop_queue.push({loop_keyframe, scan_copy()});
+    std::lock_guard lock(s.results_mutex);
+    if (s.reported < s.closures.size()) result.loop_closure = s.closures[s.reported++];
   } else if (loop_keyframe.valid() && s.options.loop_closing.enabled) {
     std::optional<Eigen::Isometry3d> T_ref_world_before;
     {
@@ -308,7 +296,10 @@ TrackResult System::track(const SensorFrame& sensor) {
       // this frame is the reference keyframe: it moves with it, as the tracker's last frames do
       if (const auto moved = s.tracker.follow_map_correction(*T_ref_world_before)) frame.T_cam_world = frame.T_cam_world * *moved;
     }
-    if (step.closure) s.closures.push_back(*step.closure);
+    if (step.closure) {
+      const std::lock_guard lock(s.results_mutex);
+      s.closures.push_back(*step.closure);
+    }
     result.loop_closure = std::move(step.closure);
   }
   result.timing.loop_ms = stage.lap_ms();
@@ -369,13 +360,12 @@ bool System::loop_closing() const { return impl_->options.loop_closing.enabled; 
 
 LoopClosingStats System::loop_statistics() const {
   if (!impl_->threaded_loop_closing()) return impl_->closer.stats();
-  std::lock_guard lock(impl_->loop_mutex);
+  std::lock_guard lock(impl_->results_mutex);
   return impl_->stats;
 }
 
 std::vector<LoopClosure> System::loop_closures() const {
-  if (!impl_->threaded_loop_closing()) return impl_->closures;
-  std::lock_guard lock(impl_->loop_mutex);
+  std::lock_guard lock(impl_->results_mutex);  // uncontended inline
   return impl_->closures;
 }
 

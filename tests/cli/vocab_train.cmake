@@ -32,29 +32,22 @@ if(NOT rc EQUAL 0 OR NOT out MATCHES "ok 12")
   message(FATAL_ERROR "run with the trained vocabulary failed (exit ${rc}): ${out}${err}")
 endif()
 
-# errors name what is wrong
+# errors name what is wrong: expect_error(<what> <regex on stderr> <command...>)
+function(expect_error what pattern)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR NOT err MATCHES "${pattern}")
+    message(FATAL_ERROR "${what}: expected an error matching '${pattern}', got exit ${rc}: ${err}")
+  endif()
+endfunction()
+set(run ${RGBL} run ${WORK_DIR}/data/sequences/00 --out ${WORK_DIR}/out2 --config)
 file(MAKE_DIRECTORY ${WORK_DIR}/empty)
-execute_process(COMMAND ${RGBL} vocab train ${WORK_DIR}/empty --out ${WORK_DIR}/c.rgblvoc RESULT_VARIABLE rc
-                ERROR_VARIABLE err)
-if(rc EQUAL 0 OR NOT err MATCHES "empty.*no \\.png/\\.jpg image")
-  message(FATAL_ERROR "a folder without images: expected an error naming it, got exit ${rc}: ${err}")
-endif()
+expect_error("a folder without images" "empty.*no \\.png/\\.jpg image"
+             ${RGBL} vocab train ${WORK_DIR}/empty --out ${WORK_DIR}/c.rgblvoc)
 file(WRITE ${WORK_DIR}/config/mine.rgblvoc "RGBLVOC1 but nothing else")
-execute_process(COMMAND ${RGBL} run ${WORK_DIR}/data/sequences/00 --config ${WORK_DIR}/config/bow.yaml
-                        --out ${WORK_DIR}/out2 RESULT_VARIABLE rc ERROR_VARIABLE err)
-if(rc EQUAL 0 OR NOT err MATCHES "mine\\.rgblvoc.*not an rgbl vocabulary")
-  message(FATAL_ERROR "a damaged vocabulary: expected an error naming it, got exit ${rc}: ${err}")
-endif()
+expect_error("a damaged vocabulary" "mine\\.rgblvoc.*not an rgbl vocabulary" ${run} ${WORK_DIR}/config/bow.yaml)
 file(WRITE ${WORK_DIR}/config/bad.yaml "%YAML:1.0\nLoopClosing.Places: \"scan_context,,bow\"\n")
-execute_process(COMMAND ${RGBL} run ${WORK_DIR}/data/sequences/00 --config ${WORK_DIR}/config/bad.yaml
-                        --out ${WORK_DIR}/out3 RESULT_VARIABLE rc ERROR_VARIABLE err)
-if(rc EQUAL 0 OR NOT err MATCHES "bad\\.yaml.*LoopClosing\\.Places")
-  message(FATAL_ERROR "an empty recogniser name: expected an error naming the key, got exit ${rc}: ${err}")
-endif()
+expect_error("an empty recogniser name" "bad\\.yaml.*LoopClosing\\.Places" ${run} ${WORK_DIR}/config/bad.yaml)
 file(WRITE ${WORK_DIR}/config/unknown.yaml "%YAML:1.0\nLoopClosing.Places: \"scan_context, netvlad\"\n")
-execute_process(COMMAND ${RGBL} run ${WORK_DIR}/data/sequences/00 --config ${WORK_DIR}/config/unknown.yaml
-                        --out ${WORK_DIR}/out4 RESULT_VARIABLE rc ERROR_VARIABLE err)
-if(rc EQUAL 0 OR NOT err MATCHES "loop_closing\\.places.*bow, scan_context.*netvlad")
-  message(FATAL_ERROR "an unknown recogniser: expected an error listing the known ones, got exit ${rc}: ${err}")
-endif()
+expect_error("an unknown recogniser" "loop_closing\\.places.*bow, scan_context.*netvlad"
+             ${run} ${WORK_DIR}/config/unknown.yaml)
 file(REMOVE_RECURSE ${WORK_DIR})

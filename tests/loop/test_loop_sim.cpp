@@ -6,11 +6,13 @@
 #include "rgbl/sim/scenarios.hpp"
 #include "rgbl/sim/synthetic.hpp"
 #include "mapped_drive.hpp"
+#include "sim_frames.hpp"
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <numbers>
 #include <optional>
 #include <vector>
@@ -29,15 +31,21 @@ Lap generate(rgbl::SyntheticOptions options) {
   Lap l;
   l.calibration = generator.calibration().camera(0);
   for (int i = 0; i < options.frames; ++i) {
-    rgbl::FrameInput f;
-    f.index = static_cast<std::size_t>(i);
-    f.timestamp = generator.timestamp(i);
-    f.images[0] = generator.render_image(i, 0);
-    f.scan = generator.render_scan(i);
-    l.frames.push_back(std::move(f));
+    l.frames.push_back(rgbl::test::render_frame(generator, i));
     l.truth.push_back(generator.pose(i));
   }
   return l;
+}
+
+// One lap of a 79 m loop (`rgbl demo --path loop --frames 80 --seed S`): the demo shrinks the loop so
+// that 80 frames drive it once.
+Lap one_lap(std::uint64_t seed) {
+  rgbl::SyntheticOptions options;
+  options.frames = 80;
+  options.seed = seed;
+  options.path.kind = rgbl::PathKind::loop;
+  options.path.loop_corner_radius = 79.0 * options.step() / (2.0 * std::numbers::pi);
+  return generate(options);
 }
 
 // Two laps of a 100 m loop (`rgbl demo --path loop --frames 201 --laps 2`): the second lap drives
@@ -115,7 +123,7 @@ TEST_CASE("loop closer: two laps of the simulator's loop are closed where the pl
   const int closures = check_closures(lap, with, 100);  // nothing before the first lap is done
   fmt::print("two laps of a 100 m loop: {} closures, ATE {:.3f} m (without loop closing {:.3f} m)\n", closures, with.ate,
              without.ate);
-  // measured: 1 closure (the map agrees with the loop afterwards), ATE 0.099 m against 1.438 m (0.079 m
+  // measured: 1 closure (the map agrees with the loop afterwards), ATE 0.099 m against 1.438 m (0.103 m
   // with the global bundle adjustment, off by default: docs/loop-closing.md)
   CHECK(closures >= 1);
   CHECK(with.loops.closures == closures);
@@ -144,11 +152,7 @@ TEST_CASE("loop closer: a drive that ends where it began is closed at its last k
   // one lap of a 79 m loop (`rgbl demo --path loop --frames 80`): only the last keyframes see the
   // first ones' places, the keyframes before them are behind the start, so the matched keyframe's
   // neighbours confirm the loop
-  rgbl::SyntheticOptions options;
-  options.frames = 80;
-  options.path.kind = rgbl::PathKind::loop;
-  options.path.loop_corner_radius = 79.0 * options.step() / (2.0 * std::numbers::pi);  // as the demo shrinks it
-  const Lap lap = generate(options);
+  const Lap lap = one_lap(1);
   const Run with = track(lap, true);
   const Run without = track(lap, false);
   const int closures = check_closures(lap, with, 70);
@@ -161,15 +165,11 @@ TEST_CASE("loop closer: a drive that ends where it began is closed at its last k
 }
 
 TEST_CASE("loop closer: the global bundle adjustment holds keyframes the shared landmarks cannot place") {
-  // one lap of 79 m, seed 3, with the (optional) global BA: by the closure the keyframes of frames
-  // 18 and 26 share only 2 observations with the rest of the map, which let the BA slide them 1.3 and
-  // 13.5 m (frames 20-35 ended 1.4-1.6 m off); now such keyframes are held and follow their parent
-  rgbl::SyntheticOptions options;
-  options.frames = 80;
-  options.seed = 3;
-  options.path.kind = rgbl::PathKind::loop;
-  options.path.loop_corner_radius = 79.0 * options.step() / (2.0 * std::numbers::pi);
-  const Lap lap = generate(options);
+  // one lap of 79 m, seed 3, with the (optional) global BA: before keyframes with too little shared
+  // evidence were held, frames 20-35 ended 1.4-1.6 m off (on the first lap of two, same seed, the
+  // keyframes of frames 18 and 26 shared 2 observations each with the rest of the map at the
+  // closure); now such keyframes are held and follow their parent
+  const Lap lap = one_lap(3);
   rgbl::LoopClosingOptions with_ba;
   with_ba.global_ba = true;
   const Run run = track(lap, with_ba);
@@ -179,7 +179,8 @@ TEST_CASE("loop closer: the global bundle adjustment holds keyframes the shared 
   for (const auto& r : run.results) held += r.loop_closure ? r.loop_closure->global_ba_held : 0;
   fmt::print("one lap of 79 m, seed 3, global BA: {} closures, {} keyframes held, worst frame {:.3f} m, ATE {:.3f} m\n",
              closures, held, worst, run.ate);
-  // measured: 1 closure, 4 keyframes held, worst frame 0.509 m (0.446 m without the BA), ATE 0.147 m
+  // measured: 1 closure, 4 keyframes held, worst frame 0.509 m (`rgbl run` of the same lap without the
+  // BA: 0.446 m), ATE 0.147 m
   // (0.345 m before keyframes were held)
   CHECK(closures == 1);
   CHECK(held >= 1);

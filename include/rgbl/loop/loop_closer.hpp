@@ -14,7 +14,7 @@
 // current map moves rigidly onto the other, its root hangs from the matched keyframe, and the same
 // correction follows.
 //
-// Not here yet (issue 14): a thread of its own.
+// In a thread of its own (System with threaded mapping), detect() and correct() are called apart.
 
 #include "rgbl/backend/bundle_adjustment.hpp"
 #include "rgbl/backend/loop_correction.hpp"
@@ -195,6 +195,8 @@ class LoopCloser {
   std::vector<KeyframeId> recent_;
   void remember(KeyframeId keyframe);
   void adjust_map(Map& map, KeyframeId keyframe, LoopClosure& closure) const;
+  // correct() without its timing.
+  void apply(Map& map, const DetectedLoop& loop, LoopCloserStep& step);
 };
 
 }  // namespace rgbl

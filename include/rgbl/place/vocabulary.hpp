@@ -48,7 +48,8 @@ class Vocabulary {
   static Vocabulary train(std::span<const std::vector<Descriptor>> images, const VocabularyOptions& options = {});
 
   // Binary file (docs/loop-closing.md, "Vocabulary file"). load throws ParseError naming the file on
-  // anything that is not a complete, intact vocabulary; save throws ParseError when it cannot write.
+  // anything that is not a complete, intact vocabulary; save writes atomically and throws Error
+  // naming the file when it cannot.
   static Vocabulary load(const std::filesystem::path& file);
   void save(const std::filesystem::path& file) const;
   // The same format from memory; `name` is what errors call the bytes.
@@ -56,7 +57,7 @@ class Vocabulary {
   std::vector<std::uint8_t> to_bytes() const;
 
   bool empty() const { return nodes_.empty(); }
-  std::size_t words() const { return words_; }
+  std::size_t words() const { return leaves_.size(); }
   std::size_t nodes() const { return nodes_.size(); }
   int branching() const { return branching_; }
   int levels() const { return levels_; }
@@ -81,7 +82,6 @@ class Vocabulary {
     friend bool operator==(const Node&, const Node&) = default;
   };
   int branching_ = 0, levels_ = 0;
-  std::size_t words_ = 0;
   std::vector<Node> nodes_;            // breadth first: node 0 is the root, parents before children
   std::vector<std::uint32_t> leaves_;  // word -> node
 };
