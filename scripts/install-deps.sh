@@ -12,7 +12,7 @@ packages=(
   catch2                                      # Catch2 2.13
   libbenchmark-dev                            # Google Benchmark 1.7
   libcli11-dev                                # CLI11
-  nlohmann-json3-dev                          # JSON (the accuracy suite's table)
+  nlohmann-json3-dev                          # JSON (summary.json, the accuracy suite's table)
 )
 # fuzzing (scripts/fuzz.sh) needs clang with its libFuzzer/sanitizer runtimes
 if [ "${RGBL_FUZZ:-0}" = "1" ]; then

@@ -2,11 +2,10 @@
 //           [--out DIR] [--no-loop-closing]
 //           [--keep DIR]
 // The main job without a dataset: generates a synthetic street (rgbl::sim) in the KITTI odometry layout
-// and tracks it through exactly the code of `rgbl run` (make_pipeline + run_pipeline), so the accuracy
+// and tracks it through exactly the code of `rgbl run` (rgbl::Pipeline), so the accuracy
 // printed is against the exact ground truth.
 #include "command.hpp"
-#include "pipeline.hpp"
-#include "run.hpp"
+#include "input_options.hpp"
 
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/timer.hpp"
@@ -149,16 +148,15 @@ int run_demo(const DemoArgs& args, bool quiet) {
              sim.width, sim.height, sim.seed, sim.driven_length(), generation_s, 1000.0 * generation_s / sim.frames);
   std::fflush(stdout);  // before the run's progress on stderr
 
-  InputOptions input;
-  input.dir = layout.sequence_dir.string();
-  input.format = "kitti";
+  PipelineOptions input;
+  input.dataset = layout.sequence_dir;
+  input.format = DatasetFormat::kitti;
   input.depth = args.depth;
   // `precomputed` alone: the exact depth images the generator wrote next to the images
   if (input.depth == "precomputed") input.depth = "precomputed:" + (layout.sequence_dir / "depth").string();
-  Pipeline pipeline = make_pipeline(input);
-  if (args.no_loop_closing) pipeline.system.loop_closing.enabled = false;
-  for (const auto& note : pipeline.notes) fmt::print(stderr, "note: {}\n", note);
-  const RunOutcome outcome = run_pipeline(pipeline, args.out, args.threaded, quiet);
+  input.threaded = args.threaded;
+  input.loop_closing = !args.no_loop_closing;
+  const RunResult run = run_and_report(Pipeline(input), args.out, quiet);
 
   if (temp) {
     fmt::print("  the generated dataset was removed (keep it with --keep <dir>)\n");
@@ -167,7 +165,7 @@ int run_demo(const DemoArgs& args, bool quiet) {
                layout.poses_file.string(), layout.sequence_dir.string());
   }
   // a demo that cannot track its own synthetic street is a failure worth an exit code
-  return outcome.tracked > 0 ? 0 : 1;
+  return run.count(TrackState::Ok) > 0 ? 0 : 1;
 }
 
 }  // namespace

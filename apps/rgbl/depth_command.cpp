@@ -3,7 +3,7 @@
 // the dataset's own depth (synthetic, RGB-D) or, for LiDAR data with ground-truth poses, against the
 // neighbouring scans accumulated into each frame (SPEC 3).
 #include "command.hpp"
-#include "pipeline.hpp"
+#include "input_options.hpp"
 
 #include "rgbl/core/timer.hpp"
 #include "rgbl/depth/completion.hpp"
@@ -75,7 +75,7 @@ class ScanWindow {
 Command add_depth_command(CLI::App& parent) {
   auto* app = parent.add_subcommand(
       "depth", "Write completed depth maps (uint16 PNG, depth x 256) and previews; report depth metrics");
-  auto options = std::make_shared<InputOptions>();
+  auto options = std::make_shared<PipelineOptions>();
   auto out_dir = std::make_shared<std::string>();
   auto half_window = std::make_shared<int>(5);
   add_input_options(*app, *options);
@@ -84,29 +84,29 @@ Command add_depth_command(CLI::App& parent) {
                   "LiDAR ground truth: accumulate the scans of +-N neighbouring frames (needs poses)")
       ->capture_default_str();
   return {app, [options, out_dir, half_window] {
-            Pipeline p = make_pipeline(*options);
-            for (const auto& note : p.notes) fmt::print(stderr, "note: {}\n", note);
+            const Pipeline p(*options);
+            for (const auto& note : p.notes()) fmt::print(stderr, "note: {}\n", note);
             const std::filesystem::path out(*out_dir);
             std::filesystem::create_directories(out / "depth");
             std::filesystem::create_directories(out / "preview");
             auto source = p.make_depth_source();
-            const auto& gt = p.sequence->ground_truth();
-            const bool lidar_gt = p.sequence->sensors().lidar && gt.has_value();
-            ScanWindow window(*p.sequence, *half_window);
+            const auto& gt = p.sequence().ground_truth();
+            const bool lidar_gt = p.sequence().sensors().lidar && gt.has_value();
+            ScanWindow window(p.sequence(), *half_window);
             AccumulationOptions accumulation;
             accumulation.half_window = *half_window;
-            accumulation.projection = p.depth_settings.lidar.projection;
+            accumulation.projection = p.depth_settings().lidar.projection;
             DepthErrorAccumulator errors;
             double density_sum = 0.0, ms_sum = 0.0;
             std::size_t frames = 0, graded = 0;
             ReadAheadOptions read;
-            read.first = p.first;
-            read.count = p.count;
-            read.step = p.step;
-            ReadAhead reader(*p.sequence, read);
+            read.first = p.first();
+            read.count = p.frame_count();
+            read.step = p.step();
+            ReadAhead reader(p.sequence(), read);
             while (auto input = reader.next()) {
               Stopwatch watch;
-              source->prepare(sensor_frame(*input, p.camera));
+              source->prepare(p.sensor_frame(*input));
               const cv::Mat_<float> dense = source->dense_depth();
               ms_sum += watch.elapsed_ms();
               density_sum += depth_density(dense);
@@ -114,14 +114,14 @@ Command add_depth_command(CLI::App& parent) {
               write_depth_png(out / "depth" / name, dense);
               cv::imwrite((out / "preview" / name).string(), colourise(dense, 80.0F));
               cv::Mat_<float> truth;
-              if (!input->depth.empty() && p.depth_name != "rgbd") {
+              if (!input->depth.empty() && p.depth_name() != "rgbd") {
                 truth = input->depth;
               } else if (lidar_gt) {
                 const auto scans = window.around(input->index);
                 std::vector<Eigen::Isometry3d> poses(gt->poses.begin() + static_cast<std::ptrdiff_t>(window.first()),
                                                      gt->poses.begin() +
                                                          static_cast<std::ptrdiff_t>(window.first() + scans.size()));
-                truth = accumulate_depth(p.calibration, scans, poses, input->index - window.first(), accumulation);
+                truth = accumulate_depth(p.calibration(), scans, poses, input->index - window.first(), accumulation);
               }
               if (!truth.empty()) {
                 errors.add(dense, truth);
@@ -129,7 +129,7 @@ Command add_depth_command(CLI::App& parent) {
               }
               ++frames;
             }
-            fmt::print("{} frames, camera {}, depth {}: density {:.1f} %, {:.2f} ms per frame\n", frames, p.camera,
+            fmt::print("{} frames, camera {}, depth {}: density {:.1f} %, {:.2f} ms per frame\n", frames, p.camera(),
                        options->depth, 100.0 * density_sum / std::max<std::size_t>(frames, 1),
                        ms_sum / std::max<std::size_t>(frames, 1));
             if (graded > 0) {

@@ -1,11 +1,13 @@
 // rgbl eval <estimate> <ground-truth>: KITTI odometry metric, ATE, RPE and end-point drift.
 #include "command.hpp"
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 #include "rgbl/eval/trajectory_metrics.hpp"
 #include "rgbl/io/trajectory_io.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -57,34 +59,12 @@ std::string detect_format(const fs::path& file) {
   throw ParseError(file, 0, "no poses in the file");
 }
 
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(c));
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
+using Json = nlohmann::ordered_json;
 
-std::string json_number(double v) {
-  return std::isfinite(v) ? fmt::format("{}", v) : "null";
-}
+Json number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
-std::string stats_json(const ErrorStats& s) {
-  return fmt::format(R"({{"rmse": {}, "mean": {}, "median": {}, "max": {}}})", json_number(s.rmse), json_number(s.mean),
-                     json_number(s.median), json_number(s.max));
-}
-
-std::string join(const std::vector<double>& v) {
-  std::string out;
-  for (std::size_t i = 0; i < v.size(); ++i) out += fmt::format("{}{}", i == 0 ? "" : ",", v[i]);
-  return out;
+Json stats_json(const ErrorStats& s) {
+  return {{"rmse", number(s.rmse)}, {"mean", number(s.mean)}, {"median", number(s.median)}, {"max", number(s.max)}};
 }
 
 int run_eval(const EvalArgs& args) {
@@ -125,22 +105,20 @@ int run_eval(const EvalArgs& args) {
         fmt::format("{} and {}: fewer than 2 poses to compare", args.estimate.string(), args.ground_truth.string()));
   }
 
-  const double path_length = trajectory_distances(gt).back();
-  KittiMetricOptions kitti;
+  KittiMetricOptions kitti = kitti_options_for_path(trajectory_distances(gt).back());
+  if (!args.lengths.empty()) kitti.lengths = args.lengths;
   kitti.step_size = args.step;
-  if (!args.lengths.empty()) {
-    kitti.lengths = args.lengths;
-  } else if (path_length <= 100.0) {
-    kitti.lengths = {10, 20, 30, 40, 50, 60};
-    notes.push_back(
-        fmt::format("the ground-truth path is {:.1f} m, too short for KITTI's 100..800 m segments: "
-                    "using 10..60 m (not comparable with published KITTI figures)",
-                    path_length));
+  const TrajectoryEvaluation evaluation = evaluate_trajectory(est, gt, kitti);
+  const double path_length = evaluation.path_length;
+  if (args.lengths.empty() && kitti.lengths != KittiMetricOptions{}.lengths) {
+    notes.push_back(fmt::format("the ground-truth path is {:.1f} m, too short for KITTI's 100..800 m segments: using {} "
+                                "(not comparable with published KITTI figures)",
+                                path_length, describe_lengths(kitti)));
   }
-  const KittiMetric metric = kitti_metric(est, gt, kitti);
-  const AteResult ate = absolute_trajectory_error(est, gt);
-  const RpeResult rpe = relative_pose_error(est, gt);
-  const DriftResult drift = end_point_drift(est, gt);
+  const KittiMetric& metric = evaluation.kitti;
+  const AteResult& ate = evaluation.ate;
+  const RpeResult& rpe = evaluation.rpe;
+  const DriftResult& drift = evaluation.drift;
 
   fmt::print("estimate:      {} ({}, {} poses)\n", args.estimate.string(), est_format, est.size());
   fmt::print("ground truth:  {} ({})\n", args.ground_truth.string(), gt_format);
@@ -170,38 +148,35 @@ int run_eval(const EvalArgs& args) {
   fmt::print("end-point drift: {:.4f} m = {:.4f} % of the path\n", drift.end_error, drift.percent);
 
   if (!args.json.empty()) {
-    std::string per_length;
-    for (std::size_t k = 0; k < metric.per_length.size(); ++k) {
-      const auto& l = metric.per_length[k];
-      per_length += fmt::format(R"({}{{"length": {}, "segments": {}, "t_err_percent": {}, "r_err_deg_per_100m": {}}})",
-                                k == 0 ? "" : ", ", l.length, l.segments, json_number(l.t_err_percent),
-                                json_number(l.r_err_deg_per_100m));
+    Json per_length = Json::array();
+    for (const auto& l : metric.per_length) {
+      per_length.push_back({{"length", l.length},
+                            {"segments", l.segments},
+                            {"t_err_percent", number(l.t_err_percent)},
+                            {"r_err_deg_per_100m", number(l.r_err_deg_per_100m)}});
     }
-    const std::string json = fmt::format(
-        "{{\n  \"estimate\": {},\n  \"ground_truth\": {},\n  \"format\": \"{}\",\n  \"poses\": {},\n"
-        "  \"path_length_m\": {},\n"
-        "  \"kitti\": {{\"lengths_m\": [{}], \"step_frames\": {}, \"segments\": {}, \"t_err_percent\": {}, "
-        "\"r_err_deg_per_100m\": {}, \"per_length\": [{}]}},\n"
-        "  \"ate_m\": {},\n  \"rpe_translation_m\": {},\n  \"rpe_rotation_deg\": {},\n"
-        "  \"drift\": {{\"end_error_m\": {}, \"percent\": {}}}\n}}\n",
-        json_string(args.estimate.generic_string()), json_string(args.ground_truth.generic_string()), est_format,
-        est.size(), json_number(path_length), join(kitti.lengths), kitti.step_size, metric.segments,
-        json_number(metric.t_err_percent), json_number(metric.r_err_deg_per_100m), per_length,
-        stats_json(ate.translation), stats_json(rpe.translation), stats_json(rpe.rotation_deg),
-        json_number(drift.end_error), json_number(drift.percent));
+    const Json json = {{"estimate", args.estimate.generic_string()},
+                       {"ground_truth", args.ground_truth.generic_string()},
+                       {"format", est_format},
+                       {"poses", est.size()},
+                       {"path_length_m", number(path_length)},
+                       {"kitti",
+                        {{"lengths_m", kitti.lengths},
+                         {"step_frames", kitti.step_size},
+                         {"segments", metric.segments},
+                         {"t_err_percent", number(metric.t_err_percent)},
+                         {"r_err_deg_per_100m", number(metric.r_err_deg_per_100m)},
+                         {"per_length", per_length}}},
+                       {"ate_m", stats_json(ate.translation)},
+                       {"rpe_translation_m", stats_json(rpe.translation)},
+                       {"rpe_rotation_deg", stats_json(rpe.rotation_deg)},
+                       {"drift", {{"end_error_m", number(drift.end_error)}, {"percent", number(drift.percent)}}}};
+    const std::string text = json.dump(2) + "\n";
     if (args.json == "-") {
-      fmt::print("{}", json);
+      fmt::print("{}", text);
     } else {
-      // Written whole and renamed, so that a failure never leaves a complete-looking report.
-      const std::string part = args.json + ".part";
-      {
-        std::ofstream out(part, std::ios::trunc);
-        out << json;
-        if (!out) throw Error(fmt::format("{}: cannot write the JSON report", args.json));
-      }
-      std::error_code ec;
-      fs::rename(part, args.json, ec);
-      if (ec) throw Error(fmt::format("{}: cannot write the JSON report ({})", args.json, ec.message()));
+      // written whole and renamed, so that a failure never leaves a complete-looking report
+      write_atomically(args.json, [&](std::ofstream& out) { out << text; });
     }
   }
   return 0;
@@ -219,8 +194,8 @@ Command add_eval_command(CLI::App& parent) {
       ->check(CLI::IsMember({"auto", "kitti", "tum"}))
       ->capture_default_str();
   app->add_option("--lengths", args->lengths,
-                  "KITTI segment lengths in metres, comma separated (default 100,...,800; 10,...,60 for "
-                  "paths up to 100 m)")
+                  "KITTI segment lengths in metres, comma separated (default 100,...,800; for paths under 800 m up "
+                  "to 8 round lengths below the path, as `rgbl run`)")
       ->delimiter(',')
       ->check(CLI::PositiveNumber);
   app->add_option("--step", args->step, "Frames between segment starts (KITTI: 10)")

@@ -178,4 +178,38 @@ DriftResult end_point_drift(std::span<const Eigen::Isometry3d> estimate,
   return d;
 }
 
+KittiMetricOptions kitti_options_for_path(double path_length) {
+  KittiMetricOptions options;
+  if (path_length >= 800.0) return options;
+  const double step = std::max(1.0, std::ceil(path_length / 80.0)) * 10.0;
+  options.lengths.clear();
+  for (double l = step; l < path_length && options.lengths.size() < 8; l += step) options.lengths.push_back(l);
+  if (options.lengths.empty()) options.lengths.push_back(std::max(1.0, std::floor(path_length / 2.0)));
+  return options;
+}
+
+std::string describe_lengths(const KittiMetricOptions& options) {
+  if (options.lengths.empty()) return "no lengths";
+  const bool kitti = options.lengths == KittiMetricOptions{}.lengths;
+  return fmt::format("{:g}..{:g} m{}", options.lengths.front(), options.lengths.back(), kitti ? "" : " (short run)");
+}
+
+TrajectoryEvaluation evaluate_trajectory(std::span<const Eigen::Isometry3d> estimate,
+                                         std::span<const Eigen::Isometry3d> ground_truth,
+                                         const std::optional<KittiMetricOptions>& kitti) {
+  if (estimate.size() != ground_truth.size() || estimate.size() < 2) {
+    throw Error(fmt::format("evaluate_trajectory: {} estimated and {} ground-truth poses (expected as many, >= 2)",
+                            estimate.size(), ground_truth.size()));
+  }
+  TrajectoryEvaluation e;
+  e.poses = estimate.size();
+  e.drift = end_point_drift(estimate, ground_truth);
+  e.path_length = e.drift.path_length;
+  e.kitti_options = kitti ? *kitti : kitti_options_for_path(e.path_length);
+  e.kitti = kitti_metric(estimate, ground_truth, e.kitti_options);
+  e.ate = absolute_trajectory_error(estimate, ground_truth);
+  e.rpe = relative_pose_error(estimate, ground_truth, 1);
+  return e;
+}
+
 }  // namespace rgbl

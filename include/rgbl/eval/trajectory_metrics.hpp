@@ -14,7 +14,9 @@
 #include <Eigen/Geometry>
 
 #include <cstddef>
+#include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace rgbl {
@@ -86,5 +88,29 @@ struct DriftResult {
 
 DriftResult end_point_drift(std::span<const Eigen::Isometry3d> estimate,
                             std::span<const Eigen::Isometry3d> ground_truth);
+
+// Segment lengths that suit a path of `path_length` m: KITTI's 100..800 m from 800 m on; a shorter
+// path gets up to 8 round lengths below its length (SPEC 6), so that it still has segments. Figures
+// with other than KITTI's lengths are not comparable with published ones.
+KittiMetricOptions kitti_options_for_path(double path_length);
+
+// "100..800 m", or "10..50 m (short run)" for lengths other than KITTI's.
+std::string describe_lengths(const KittiMetricOptions& options);
+
+// Every metric above at once, as `rgbl run` and `rgbl eval` report them.
+struct TrajectoryEvaluation {
+  std::size_t poses = 0;
+  double path_length = 0.0;  // m, ground truth
+  KittiMetricOptions kitti_options;
+  KittiMetric kitti;
+  AteResult ate;
+  RpeResult rpe;  // per frame
+  DriftResult drift;
+};
+
+// At least 2 poses. The KITTI lengths are kitti_options_for_path(path) unless `kitti` is given.
+TrajectoryEvaluation evaluate_trajectory(std::span<const Eigen::Isometry3d> estimate,
+                                         std::span<const Eigen::Isometry3d> ground_truth,
+                                         const std::optional<KittiMetricOptions>& kitti = std::nullopt);
 
 }  // namespace rgbl

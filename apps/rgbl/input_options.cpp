@@ -1,0 +1,107 @@
+#include "input_options.hpp"
+
+#include "rgbl/core/timer.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+
+namespace rgbl::cli {
+namespace {
+
+void print_summary(const RunResult& run, const std::filesystem::path& out_dir) {
+  const RunTimings t = run.timings();
+  const auto frames = [&run](auto&& selected) {
+    std::string list;
+    for (const auto& r : run.frames) {
+      if (selected(r.result)) list += (list.empty() ? "" : ", ") + std::to_string(r.result.frame_index);
+    }
+    return list;
+  };
+  fmt::print("\n{} ({}), camera {}, depth {}: {} frames in {:.1f} s\n", run.sequence_name, to_string(run.format),
+             run.camera, run.depth, run.frames.size(), run.wall_s);
+  fmt::print("  ok {}, weak {}, lost {}, not initialised {}; {} keyframes, {} landmarks\n",
+             run.count(TrackState::Ok), run.count(TrackState::Weak), run.count(TrackState::Lost),
+             run.count(TrackState::NotInitialised), run.keyframe_count(), run.landmarks.size());
+  const std::string jumps = frames([](const TrackResult& r) { return r.jump; });
+  const std::string new_maps = frames([](const TrackResult& r) { return r.new_map; });
+  if (!jumps.empty()) fmt::print("  steps beyond a vehicle's reach taken at frame(s) {}\n", jumps);
+  if (!new_maps.empty()) fmt::print("  lost beyond relocalisation: new map started at frame(s) {}\n", new_maps);
+  if (run.loop_statistics.implausible > 0) {
+    fmt::print("  loop closing refused {} verified loop(s) asking for more correction than odometry can drift\n",
+               run.loop_statistics.implausible);
+  }
+  for (const LoopClosure& c : run.loop_closures) {
+    fmt::print("  {} at frame {} with frame {}: map moved {:.2f} m / {:.2f} deg there, {} landmarks fused, "
+               "{:.0f} ms (global BA of {} keyframes {:.0f} ms)\n",
+               c.merged ? "maps merged" : "loop closed", c.frame_index, c.matched_frame_index, c.correction_m,
+               c.correction_deg, c.fused_landmarks, c.time_ms, c.global_ba_keyframes, c.global_ba_ms);
+  }
+  fmt::print("  per frame (median / p95 ms): depth {:.2f} / {:.2f}, extraction {:.2f} / {:.2f}, tracking {:.2f} / "
+             "{:.2f}, mapping {:.2f} / {:.2f}\n",
+             t.depth.median, t.depth.p95, t.extraction.median, t.extraction.p95, t.tracking.median, t.tracking.p95,
+             t.mapping.median, t.mapping.p95);
+  fmt::print("  depth+extraction+tracking {:.2f} ms median; total {:.2f} ms median, {:.2f} ms mean\n", t.front.median,
+             t.total.median, t.total.mean);
+  if (run.metrics) {
+    const TrajectoryEvaluation& e = run.metrics->evaluation;
+    fmt::print("  ATE RMSE {:.3f} m, end-point drift {:.2f} %, KITTI metric ({}) {:.2f} % / {:.3f} deg/100m\n",
+               e.ate.translation.rmse, e.drift.percent, run.metrics->kitti_lengths, e.kitti.t_err_percent,
+               e.kitti.r_err_deg_per_100m);
+  } else {
+    fmt::print("  no ground truth: no accuracy figures\n");
+  }
+  fmt::print("  outputs in {}: trajectory_kitti.txt trajectory_tum.txt timing.csv summary.json trajectory.svg "
+             "map.ply\n",
+             out_dir.string());
+}
+
+}  // namespace
+
+void add_input_options(CLI::App& app, PipelineOptions& options) {
+  app.add_option("dir", options.dataset, "Dataset folder: KITTI odometry sequences/NN, KITTI raw drive, or TUM RGB-D")
+      ->required();
+  app.add_option_function<std::string>(
+         "--format", [&options](const std::string& name) { options.format = parse_dataset_format(name); },
+         "Dataset layout (auto detects it)")
+      ->check(CLI::IsMember({"auto", "kitti", "kitti-raw", "tum"}));
+  app.add_option("--camera", options.camera, "Tracked camera: 0 (grey left, the default when present) or 2 (colour left)")
+      ->check(CLI::IsMember({0, 2}));
+  app.add_option("--depth", options.depth,
+                 "Depth source: lidar (5x5 diamond; keypoints at their surface's mean depth), lidar:dilated "
+                 "(keypoints at the dilated value, as the paper), lidar:ipbasic, lidar:ipbasic-multiscale, lidar:diamond7, "
+                 "precomputed:<dir>, stereo (SGBM), stereo_sparse (keypoints only), rgbd")
+      ->capture_default_str();
+  app.add_option("--config", options.settings, "Settings YAML (ORB-SLAM style; RGB-L LiDAR.* keys accepted)");
+  app.add_option("--frames", options.frames, "Number of frames to process (default: all)");
+  app.add_option("--first", options.first, "First frame to process");
+  app.add_option("--step", options.step, "Process every N-th frame (e.g. 2: KITTI at 5 Hz)")
+      ->check(CLI::PositiveNumber);
+}
+
+RunResult run_and_report(const Pipeline& pipeline, const std::filesystem::path& out_dir, bool quiet) {
+  for (const auto& note : pipeline.notes()) fmt::print(stderr, "note: {}\n", note);
+  const bool tty = ::isatty(STDERR_FILENO) != 0;
+  Stopwatch wall, clock;
+  const auto progress = [&](const FrameRecord& record, std::size_t done, std::size_t total) {
+    if (quiet || (clock.elapsed_ms() <= 1000.0 && done != total)) return;
+    clock.restart();
+    const std::string line =
+        fmt::format("frame {}/{}  {}  {:.1f} ms  {:.1f} frames/s", done, total, to_string(record.result.state),
+                    record.result.timing.total_ms, static_cast<double>(done) / (wall.elapsed_ms() / 1000.0));
+    if (tty) {
+      fmt::print(stderr, "\r{:<70}", line);
+    } else {
+      fmt::print(stderr, "{}\n", line);
+    }
+  };
+  const RunResult run = pipeline.run(progress);
+  if (!quiet && tty) fmt::print(stderr, "\n");
+  write_run_outputs(run, out_dir);
+  print_summary(run, out_dir);
+  return run;
+}
+
+}  // namespace rgbl::cli

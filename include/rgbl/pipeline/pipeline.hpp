@@ -1,0 +1,166 @@
+#pragma once
+// What `rgbl run` does, as a library: open a dataset, choose the depth source and options, track every
+// frame, re-express the poses in the ground truth's world, evaluate, and write every output.
+//
+//   rgbl::PipelineOptions options;
+//   options.dataset = "sequences/04";
+//   const rgbl::Pipeline pipeline(options);
+//   const rgbl::RunResult result = pipeline.run();
+//   rgbl::write_run_outputs(result, "out");  // trajectory_kitti.txt, summary.json, ...
+
+#include "rgbl/depth/registry.hpp"
+#include "rgbl/eval/trajectory_metrics.hpp"
+#include "rgbl/features/orb.hpp"
+#include "rgbl/io/sequence.hpp"
+#include "rgbl/io/trajectory_io.hpp"
+#include "rgbl/tracking/system.hpp"
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rgbl {
+
+struct PipelineOptions {
+  std::filesystem::path dataset;  // KITTI odometry sequences/NN, KITTI raw drive or TUM RGB-D folder
+  DatasetFormat format = DatasetFormat::automatic;
+  int camera = -1;          // tracked camera, 0 or 2; -1: 0 when the dataset has it, else 2
+  std::size_t first = 0;    // first frame
+  std::size_t frames = 0;   // frames to process; 0 = all
+  std::size_t step = 1;     // every step-th frame (2: KITTI at 5 Hz)
+  // Depth source: name[:argument] of the registry, e.g. lidar, lidar:diamond7, precomputed:<dir>, stereo.
+  std::string depth = "lidar";
+  std::filesystem::path settings;  // ORB-SLAM style settings YAML (RGB-L's LiDAR.* keys too); empty: defaults
+  bool threaded = false;           // local mapping and loop closing in threads of their own
+  bool loop_closing = true;        // false overrides the settings file
+
+  // Throws ConfigError naming the option (dataset, camera, step).
+  void validate() const;
+};
+
+// One tracked frame and how long the tracker waited for it to be loaded.
+struct FrameRecord {
+  TrackResult result;
+  double io_wait_ms = 0.0;
+};
+
+struct StageStats {
+  double median = 0.0, p95 = 0.0, mean = 0.0, max = 0.0;  // ms; 0 for no samples
+};
+StageStats stage_stats(std::vector<double> samples_ms);
+
+// Per-frame timing of every stage over a run.
+struct RunTimings {
+  StageStats io_wait, depth, extraction, tracking, mapping, loop;
+  StageStats front;  // depth + extraction + tracking: what a frame waits for before its pose
+  StageStats total;
+};
+
+// Accuracy against the ground truth over the frames it covers.
+struct RunMetrics {
+  std::size_t frames_with_ground_truth = 0;
+  TrajectoryEvaluation evaluation;
+  std::string kitti_lengths;  // describe_lengths() of the lengths used
+};
+
+// Everything a run produced, in the ground truth's world frame: poses are T_world_cam0 of KITTI's
+// reference camera (so trajectory files line up with poses/NN.txt) whatever the tracked camera; with
+// no ground truth the world is the first frame's cam0.
+struct RunResult {
+  // what ran
+  std::string sequence_name;
+  std::filesystem::path sequence_path;
+  DatasetFormat format = DatasetFormat::automatic;
+  int camera = 0;
+  std::string depth;  // the depth source's registry name
+  std::size_t first = 0, step = 1;
+  bool threaded = false;
+  bool loop_closing = false;
+
+  std::vector<FrameRecord> frames;
+  Trajectory trajectory;                        // a pose per frame, corrected by every loop closure
+  std::vector<Eigen::Isometry3d> ground_truth;  // rows of `trajectory` that have ground truth (from the first)
+  std::vector<LoopClosure> loop_closures;
+  LoopClosingStats loop_statistics;
+  std::vector<Eigen::Vector3d> landmarks;     // the final map
+  std::vector<Eigen::Isometry3d> keyframes;   // T_world_cam0 of every keyframe
+  double wall_s = 0.0;
+  std::optional<RunMetrics> metrics;          // with >= 2 frames of ground truth
+
+  std::size_t count(TrackState state) const;
+  std::size_t keyframe_count() const;
+  std::optional<int> min_inliers_ok() const;  // fewest local-map inliers on a frame reported ok
+  RunTimings timings() const;
+};
+
+// A dataset opened and every option resolved and validated: construction fails early, naming the
+// option, file or key that is wrong, before any frame is tracked.
+class Pipeline {
+ public:
+  // Throws rgbl::Error (ConfigError, ParseError). `registry` resolves options.depth.
+  explicit Pipeline(const PipelineOptions& options,
+                    const DepthSourceRegistry& registry = DepthSourceRegistry::with_builtins());
+
+  const PipelineOptions& options() const { return options_; }
+  const Sequence& sequence() const { return *sequence_; }
+  int camera() const { return camera_; }
+  const CameraCalibration& calibration() const { return calibration_; }
+  const std::string& depth_name() const { return depth_name_; }
+  const DepthSourceSettings& depth_settings() const { return depth_settings_; }
+  const SystemOptions& system_options() const { return system_; }
+  const OrbOptions& orb_options() const { return orb_; }
+  std::size_t first() const { return first_; }
+  std::size_t step() const { return step_; }
+  std::size_t frame_count() const { return count_; }   // frames run() tracks
+  std::size_t frame_index(std::size_t i) const { return first_ + i * step_; }
+  // Decisions taken on the user's behalf (e.g. "LiDAR.Tr overrides the dataset's extrinsics"), to show once.
+  const std::vector<std::string>& notes() const { return notes_; }
+
+  std::unique_ptr<DepthSource> make_depth_source() const;
+  FeatureExtractor make_extractor() const;
+  // The depth source's view of one loaded frame of the tracked camera (images shared, not copied).
+  SensorFrame sensor_frame(const FrameInput& input) const;
+
+  // Called after every frame with the frames done so far; a place for progress output.
+  using Progress = std::function<void(const FrameRecord& record, std::size_t done, std::size_t total)>;
+  // Tracks every frame (the next ones loaded on a second thread), waits for threaded mapping and loop
+  // closing, and evaluates. Throws what loading a frame throws (ParseError naming the file).
+  RunResult run(const Progress& progress = {}) const;
+
+ private:
+  PipelineOptions options_;
+  std::unique_ptr<Sequence> sequence_;
+  DepthSourceRegistry registry_;
+  int camera_ = 0;
+  CameraCalibration calibration_;
+  std::string depth_name_;
+  DepthSourceSettings depth_settings_;
+  SystemOptions system_;
+  OrbOptions orb_;
+  std::size_t first_ = 0, count_ = 0, step_ = 1;
+  std::vector<std::string> notes_;
+};
+
+// The files write_run_outputs() writes.
+const std::vector<std::string>& run_output_files();
+
+// Removes an earlier run's outputs from `out_dir` (an output left over from it would look like this
+// run's if this one fails).
+void remove_run_outputs(const std::filesystem::path& out_dir);
+
+// Writes into `out_dir` (created): trajectory_kitti.txt, trajectory_tum.txt, ground_truth_kitti.txt
+// (with ground truth; row for row with trajectory_kitti.txt), timing.csv (a row per frame, a column
+// per stage), summary.json, trajectory.svg (with the ground truth and the loop closures) and map.ply
+// (landmarks and keyframes). Each file is written whole and renamed into place.
+void write_run_outputs(const RunResult& result, const std::filesystem::path& out_dir);
+
+// summary.json's content.
+std::string summary_json(const RunResult& result);
+
+}  // namespace rgbl

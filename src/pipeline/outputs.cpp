@@ -1,0 +1,202 @@
+// A run's files: trajectories (KITTI and TUM, which evo reads), timing.csv, summary.json, the plot
+// and the map. Every file is written whole and renamed into place.
+#include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
+#include "rgbl/io/ply.hpp"
+#include "rgbl/io/svg_plot.hpp"
+#include "rgbl/pipeline/pipeline.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <system_error>
+#include <unordered_map>
+
+namespace rgbl {
+namespace {
+
+using Json = nlohmann::ordered_json;  // keys in the order written, for people reading the file
+
+// NaN and infinities are not JSON: null.
+Json number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+Json stage(const StageStats& s) {
+  return {{"median", number(s.median)}, {"p95", number(s.p95)}, {"mean", number(s.mean)}, {"max", number(s.max)}};
+}
+
+template <typename Selected>
+Json frame_list(const RunResult& run, Selected&& selected) {
+  Json list = Json::array();
+  for (const auto& r : run.frames) {
+    if (selected(r.result)) list.push_back(r.result.frame_index);
+  }
+  return list;
+}
+
+Json closure_json(const LoopClosure& c) {
+  return {{"frame", c.frame_index},
+          {"matched_frame", c.matched_frame_index},
+          {"merge", c.merged},
+          {"place", c.place_source},
+          {"place_similarity", number(c.place_similarity)},
+          {"inliers", c.inliers},
+          {"correction_m", number(c.correction_m)},
+          {"correction_deg", number(c.correction_deg)},
+          {"loop_error_before_m", number(c.correction.loop_error_before_m)},
+          {"loop_error_after_m", number(c.correction.loop_error_after_m)},
+          {"fused_landmarks", c.fused_landmarks},
+          {"global_ba",
+           {{"keyframes", c.global_ba_keyframes},
+            {"held", c.global_ba_held},
+            {"landmarks", c.global_ba_landmarks},
+            {"outliers", c.global_ba_outliers},
+            {"time_ms", number(c.global_ba_ms)}}},
+          {"time_ms", number(c.time_ms)}};
+}
+
+Json metrics_json(const RunMetrics& m) {
+  const TrajectoryEvaluation& e = m.evaluation;
+  return {{"frames_with_ground_truth", m.frames_with_ground_truth},
+          {"path_length_m", number(e.path_length)},
+          {"ate_rmse_m", number(e.ate.translation.rmse)},
+          {"ate_max_m", number(e.ate.translation.max)},
+          {"end_point_drift_m", number(e.drift.end_error)},
+          {"end_point_drift_percent", number(e.drift.percent)},
+          {"rpe_translation_rmse_m", number(e.rpe.translation.rmse)},
+          {"rpe_rotation_rmse_deg", number(e.rpe.rotation_deg.rmse)},
+          {"kitti",
+           {{"lengths", m.kitti_lengths},
+            {"segments", e.kitti.segments},
+            {"t_err_percent", number(e.kitti.t_err_percent)},
+            {"r_err_deg_per_100m", number(e.kitti.r_err_deg_per_100m)}}}};
+}
+
+void write_text(const std::filesystem::path& file, const std::string& text) {
+  write_atomically(file, [&](std::ofstream& out) { out << text; });
+}
+
+std::string timing_csv(const RunResult& run) {
+  std::string csv =
+      "frame,timestamp,state,keyframe,keypoints,keypoints_with_depth,inliers,io_wait_ms,depth_ms,"
+      "extraction_ms,tracking_ms,mapping_ms,loop_ms,total_ms\n";
+  for (const auto& r : run.frames) {
+    const auto& t = r.result.timing;
+    csv += fmt::format("{},{:.6f},{},{},{},{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f}\n",
+                       r.result.frame_index, r.result.timestamp, to_string(r.result.state), r.result.keyframe ? 1 : 0,
+                       r.result.keypoints, r.result.keypoints_with_depth, r.result.inliers, r.io_wait_ms,
+                       t.depth_ms, t.extraction_ms, t.tracking_ms, t.mapping_ms, t.loop_ms, t.total_ms);
+  }
+  return csv;
+}
+
+void write_plot(const RunResult& run, const std::filesystem::path& file) {
+  std::vector<PlotSeries> series;
+  if (!run.ground_truth.empty()) {
+    PlotSeries g{"ground truth", "#444444", {}, true};
+    for (const auto& T : run.ground_truth) g.positions.push_back(T.translation());
+    series.push_back(std::move(g));
+  }
+  const auto& poses = run.trajectory.poses;
+  PlotSeries e{fmt::format("rgbl ({})", run.depth), "#d62728", {}, false};
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const bool ok = i < run.frames.size() && has_pose(run.frames[i].result.state);
+    e.positions.push_back(ok ? Eigen::Vector3d(poses[i].translation()) : Eigen::Vector3d::Constant(std::nan("")));
+  }
+  series.push_back(std::move(e));
+  // each loop closure joins its frame to the frame it matched, both as finally estimated
+  std::unordered_map<std::size_t, std::size_t> row_of_frame;  // dataset frame index -> trajectory row
+  for (std::size_t i = 0; i < run.frames.size() && i < poses.size(); ++i) {
+    row_of_frame[run.frames[i].result.frame_index] = i;
+  }
+  std::vector<PlotLink> links;
+  for (const LoopClosure& c : run.loop_closures) {
+    const auto current = row_of_frame.find(c.frame_index);
+    const auto matched = row_of_frame.find(c.matched_frame_index);
+    if (current == row_of_frame.end() || matched == row_of_frame.end()) continue;
+    links.push_back({poses[current->second].translation(), poses[matched->second].translation(),
+                     fmt::format("{}-{}", c.frame_index, c.matched_frame_index)});
+  }
+  write_trajectory_svg(file, series, fmt::format("{}: camera {}, depth {}", run.sequence_name, run.camera, run.depth),
+                       links);
+}
+
+}  // namespace
+
+const std::vector<std::string>& run_output_files() {
+  static const std::vector<std::string> files = {"trajectory_kitti.txt", "trajectory_tum.txt",
+                                                 "ground_truth_kitti.txt", "timing.csv",
+                                                 "summary.json", "trajectory.svg", "map.ply"};
+  return files;
+}
+
+void remove_run_outputs(const std::filesystem::path& out_dir) {
+  for (const auto& name : run_output_files()) {
+    std::error_code ec;
+    std::filesystem::remove(out_dir / name, ec);
+  }
+}
+
+std::string summary_json(const RunResult& run) {
+  const RunTimings t = run.timings();
+  const LoopClosingStats& l = run.loop_statistics;
+  Json closures = Json::array();
+  for (const auto& c : run.loop_closures) closures.push_back(closure_json(c));
+  const auto min_inliers = run.min_inliers_ok();
+  Json j;
+  j["sequence"] = run.sequence_path.string();
+  j["format"] = std::string(to_string(run.format));
+  j["camera"] = run.camera;
+  j["depth"] = run.depth;
+  j["first_frame"] = run.first;
+  j["step"] = run.step;
+  j["frames"] = run.frames.size();
+  j["tracked"] = run.count(TrackState::Ok);
+  j["weak"] = run.count(TrackState::Weak);
+  j["lost"] = run.count(TrackState::Lost);
+  j["not_initialised"] = run.count(TrackState::NotInitialised);
+  j["weak_frames"] = frame_list(run, [](const TrackResult& r) { return r.state == TrackState::Weak; });
+  j["lost_frames"] = frame_list(run, [](const TrackResult& r) { return r.state == TrackState::Lost; });
+  // where tracking, lost beyond relocalisation, started a new map anchored at a guessed pose
+  j["new_map_frames"] = frame_list(run, [](const TrackResult& r) { return r.new_map; });
+  // steps beyond a vehicle's reach: taken on strong evidence, or rejected (the frame placed at the prediction)
+  j["jump_frames"] = frame_list(run, [](const TrackResult& r) { return r.jump; });
+  j["rejected_step_frames"] = frame_list(run, [](const TrackResult& r) { return r.step_rejected; });
+  j["min_inliers_ok"] = min_inliers ? Json(*min_inliers) : Json(nullptr);
+  j["keyframes"] = run.keyframe_count();
+  j["landmarks"] = run.landmarks.size();
+  j["loop_closing"] = run.loop_closing;
+  j["loop_closures"] = std::move(closures);
+  j["loop_candidates"] = {{"keyframes", l.keyframes},   {"candidates", l.candidates}, {"verified", l.verified},
+                          {"implausible", l.implausible}, {"consistent", l.consistent}, {"confirming", l.confirming},
+                          {"closures", l.closures},     {"merges", l.merges},         {"time_ms", number(l.time_ms)}};
+  j["threaded_mapping"] = run.threaded;
+  j["wall_s"] = number(run.wall_s);
+  j["stage_ms"] = {{"io_wait", stage(t.io_wait)},
+                   {"depth", stage(t.depth)},
+                   {"extraction", stage(t.extraction)},
+                   {"tracking", stage(t.tracking)},
+                   {"mapping", stage(t.mapping)},
+                   {"loop", stage(t.loop)},
+                   {"depth_extraction_tracking", stage(t.front)},
+                   {"total", stage(t.total)}};
+  j["metrics"] = run.metrics ? metrics_json(*run.metrics) : Json(nullptr);
+  return j.dump(2) + "\n";
+}
+
+void write_run_outputs(const RunResult& run, const std::filesystem::path& out_dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) throw Error(fmt::format("{}: cannot create the output folder ({})", out_dir.string(), ec.message()));
+  write_kitti_trajectory(out_dir / "trajectory_kitti.txt", run.trajectory.poses);
+  write_tum_trajectory(out_dir / "trajectory_tum.txt", run.trajectory);
+  // the ground truth of the frames run, row for row with trajectory_kitti.txt (for evo and plots; a
+  // raw drive's comes from OXTS and has no file of its own)
+  if (!run.ground_truth.empty()) write_kitti_trajectory(out_dir / "ground_truth_kitti.txt", run.ground_truth);
+  write_text(out_dir / "timing.csv", timing_csv(run));
+  write_text(out_dir / "summary.json", summary_json(run));
+  write_plot(run, out_dir / "trajectory.svg");
+  write_ply(out_dir / "map.ply", run.landmarks, {}, run.keyframes);
+}
+
+}  // namespace rgbl

@@ -1,0 +1,349 @@
+#include "rgbl/pipeline/pipeline.hpp"
+
+#include "rgbl/core/error.hpp"
+#include "rgbl/core/timer.hpp"
+#include "rgbl/io/read_ahead.hpp"
+#include "rgbl/io/settings.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <mutex>
+#include <shared_mutex>
+#include <system_error>
+
+namespace rgbl {
+namespace {
+
+// name[:argument] of --depth: lidar | lidar:dilated | lidar:ipbasic | lidar:ipbasic-multiscale |
+// lidar:<kernel><size> (e.g. lidar:diamond7) | precomputed:<dir> | stereo | stereo_sparse | rgbd
+void apply_depth_spec(const std::string& spec, const DepthSourceRegistry& registry, std::string& name,
+                      DepthSourceSettings& settings) {
+  const auto colon = spec.find(':');
+  name = spec.substr(0, colon);
+  const std::string arg = colon == std::string::npos ? std::string() : spec.substr(colon + 1);
+  auto& lidar = settings.lidar;
+  if (name == "lidar") {
+    if (arg.empty() || arg == "dilation") return;
+    if (arg == "dilated") {
+      lidar.keypoint_depth = KeypointDepthRule::dilated;  // the paper's keypoint depth: the dense map's value
+    } else if (arg == "ipbasic" || arg == "ipbasic-fast") {
+      lidar.completion = CompletionMethod::ip_basic_fast;
+    } else if (arg == "ipbasic-multiscale") {
+      lidar.completion = CompletionMethod::ip_basic_multiscale;
+    } else {
+      // <shape><size>, e.g. diamond5, rectangle3, cross7
+      const auto digit = arg.find_first_of("0123456789");
+      if (digit == std::string::npos || digit == 0) {
+        throw ConfigError("--depth", fmt::format("lidar, lidar:dilated, lidar:ipbasic, lidar:ipbasic-multiscale or "
+                                                 "lidar:<diamond|rectangle|cross><size>, not '{}'",
+                                                 spec));
+      }
+      lidar.dilation.shape = parse_kernel_shape(arg.substr(0, digit), "--depth");
+      // std::stoi would accept "7x" and throw a bare "stoi" on overflow: parse the whole tail.
+      const std::string size = arg.substr(digit);
+      int value = 0;
+      const auto [end, ec] = std::from_chars(size.data(), size.data() + size.size(), value);
+      if (ec != std::errc() || end != size.data() + size.size() || value < 1 || value > 63 || value % 2 == 0) {
+        throw ConfigError("--depth", fmt::format("an odd kernel size 1..63 after the shape (e.g. lidar:diamond5), "
+                                                 "not '{}'", spec));
+      }
+      lidar.dilation.size = value;
+    }
+  } else if (name == "precomputed") {
+    if (arg.empty()) throw ConfigError("--depth", "precomputed:<folder of uint16 depth PNGs>");
+    settings.precomputed.folder = arg;
+  } else if (name == "stereo" || name == "stereo_sparse" || name == "rgbd") {
+    if (!arg.empty()) throw ConfigError("--depth", fmt::format("'{}' without an argument", name));
+  } else if (!registry.contains(name)) {
+    throw ConfigError("--depth", fmt::format("one of lidar[:...], precomputed:<dir>, stereo, stereo_sparse, rgbd; not '{}'", spec));
+  }
+}
+
+struct Resolved {
+  CameraCalibration& calibration;
+  DepthSourceSettings& depth;
+  SystemOptions& system;
+  OrbOptions& orb;
+  std::vector<std::string>& notes;
+};
+
+void apply_settings(const Settings& s, Resolved p) {
+  for (const auto& w : s.warnings) p.notes.push_back(w);  // each already names the file
+  p.orb.num_features = s.orb.n_features;
+  p.orb.num_levels = s.orb.n_levels;
+  p.orb.scale_factor = static_cast<float>(s.orb.scale_factor);
+  p.orb.fast_threshold = s.orb.ini_th_fast;
+  p.orb.fast_min_threshold = s.orb.min_th_fast;
+  if (s.orb.features_per_node) p.orb.features_per_node = *s.orb.features_per_node;
+  if (s.orb.spread_fraction) p.orb.spread_fraction = *s.orb.spread_fraction;
+  p.depth.lidar.projection = s.projection;
+  p.depth.lidar.dilation.max_depth = s.projection.max_depth;
+  if (!s.lidar_method.empty() && s.lidar_method != "InverseDilation") {
+    throw ConfigError("LiDAR.Method", fmt::format("InverseDilation (the only method of the reference settings "
+                                                  "rgbl maps; use --depth lidar:ipbasic for IP-Basic), not '{}'",
+                                                  s.lidar_method));
+  }
+  if (!s.kernel_type.empty()) {
+    std::string shape = s.kernel_type;
+    for (auto& c : shape) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    p.depth.lidar.dilation.shape = parse_kernel_shape(shape, "LiDAR.MethodInverseDilation.KernelType");
+  }
+  if (s.kernel_size > 0) p.depth.lidar.dilation.size = s.kernel_size;
+  if (s.T_cam_lidar) {
+    p.calibration.T_cam_lidar = *s.T_cam_lidar;
+    p.notes.push_back(fmt::format("{}: LiDAR.Tr overrides the dataset's LiDAR extrinsics", s.file.string()));
+  }
+  if (s.camera) {
+    const auto& c = *s.camera;
+    const auto& d = p.calibration.camera;
+    if (std::abs(c.fx - d.fx) > 1e-3 || std::abs(c.fy - d.fy) > 1e-3 || std::abs(c.cx - d.cx) > 1e-3 ||
+        std::abs(c.cy - d.cy) > 1e-3) {
+      p.notes.push_back(fmt::format("{}: Camera.fx/fy/cx/cy differ from the dataset's calibration; using the "
+                                    "dataset's (the settings file may be for another sequence)",
+                                    s.file.string()));
+    }
+  }
+  if (s.depth_map_factor) p.depth.rgbd.scale = *s.depth_map_factor;
+  LoopClosingOptions& loop = p.system.loop_closing;
+  const LoopClosingSettings& l = s.loop_closing;
+  if (l.enabled) loop.enabled = *l.enabled;
+  if (l.max_place_distance) loop.places.scan_context.max_distance = *l.max_place_distance;
+  if (l.places) loop.places.methods = *l.places;
+  if (l.vocabulary) loop.places.bow.vocabulary = l.vocabulary->string();
+  if (l.consistent_keyframes) loop.consistent_keyframes = *l.consistent_keyframes;
+  if (l.max_drift_percent) loop.max_drift_percent = *l.max_drift_percent;
+  if (l.max_drift_deg_per_100m) loop.max_drift_deg_per_100m = *l.max_drift_deg_per_100m;
+  if (l.fuse) loop.fuse = *l.fuse;
+  if (l.global_ba) loop.global_ba = *l.global_ba;
+  if (l.merge_maps) loop.merge_maps = *l.merge_maps;
+  if (s.bf || s.th_depth) {
+    p.notes.push_back("Camera.bf / ThDepth are not used: rgbl weights depth with an explicit noise model");
+  }
+}
+
+}  // namespace
+
+void PipelineOptions::validate() const {
+  if (dataset.empty()) throw ConfigError("dataset", "a dataset folder");
+  if (camera != -1 && camera != 0 && camera != 2) {
+    throw ConfigError("camera", fmt::format("0 (grey left), 2 (colour left) or -1 (0 when present), not {}", camera));
+  }
+  if (step < 1) throw ConfigError("step", "a stride of at least 1 frame");
+  if (depth.empty()) throw ConfigError("depth", "a depth source name (lidar, precomputed:<dir>, stereo, ...)");
+}
+
+Pipeline::Pipeline(const PipelineOptions& options, const DepthSourceRegistry& registry)
+    : options_(options), registry_(registry) {
+  options_.validate();
+  sequence_ = open_sequence(options_.dataset, options_.format);
+  const auto& sensors = sequence_->sensors();
+  // The tracker works on grey images: a native grey camera (0) is the default, the colour camera (2)
+  // is converted per frame.
+  camera_ = options_.camera >= 0 ? options_.camera : (sensors.cameras[0] ? 0 : 2);
+  if (!sensors.cameras[static_cast<std::size_t>(camera_)]) {
+    throw ConfigError("--camera", fmt::format("a camera the dataset has ({} has no camera {})",
+                                              sequence_->path().string(), camera_));
+  }
+  const KittiCalibration& kitti = sequence_->calibration();
+  calibration_ = kitti.camera(camera_);
+  if (sensors.cameras[static_cast<std::size_t>(camera_ + 1)]) {
+    depth_settings_.stereo_baseline = kitti.baseline(camera_, camera_ + 1);
+  }
+  apply_depth_spec(options_.depth, registry_, depth_name_, depth_settings_);
+  if (!options_.settings.empty()) {
+    const Settings settings = read_settings(options_.settings);
+    try {
+      apply_settings(settings, {calibration_, depth_settings_, system_, orb_, notes_});
+    } catch (const ConfigError& e) {
+      throw ParseError(settings.file, 0, e.what());  // name the settings file, not just the key
+    }
+  }
+  depth_settings_.calibration = calibration_;
+  system_.threaded_mapping = options_.threaded;
+  if (!options_.loop_closing) system_.loop_closing.enabled = false;
+
+  if (depth_name_ == "lidar" && !sensors.lidar) {
+    throw ConfigError("--depth", fmt::format("a source the dataset has: {} has no LiDAR scans (try stereo or rgbd)",
+                                             sequence_->path().string()));
+  }
+  if ((depth_name_ == "stereo" || depth_name_ == "stereo_sparse") &&
+      !sensors.cameras[static_cast<std::size_t>(camera_ + 1)]) {
+    throw ConfigError("--depth", fmt::format("{} needs camera {} (image_{}) next to camera {}", depth_name_,
+                                             camera_ + 1, camera_ + 1, camera_));
+  }
+  if (depth_name_ == "rgbd" && !sensors.depth) {
+    throw ConfigError("--depth", fmt::format("rgbd needs depth images: {} has none", sequence_->path().string()));
+  }
+  const std::size_t size = sequence_->size();
+  if (options_.first >= size) {
+    throw ConfigError("--first", fmt::format("a frame index below {} (the sequence's length)", size));
+  }
+  first_ = options_.first;
+  step_ = options_.step;
+  const std::size_t available = (size - first_ + step_ - 1) / step_;
+  count_ = options_.frames == 0 ? available : std::min(options_.frames, available);
+  orb_.validate();
+  system_.validate();
+  // creating the source once validates its options before any frame is read
+  (void)make_depth_source();
+}
+
+std::unique_ptr<DepthSource> Pipeline::make_depth_source() const {
+  return registry_.create(depth_name_, depth_settings_);
+}
+
+FeatureExtractor Pipeline::make_extractor() const {
+  auto extractor = std::make_shared<OrbExtractor>(orb_);
+  return [extractor](const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors) {
+    extractor->extract(gray, keypoints, descriptors);
+  };
+}
+
+SensorFrame Pipeline::sensor_frame(const FrameInput& input) const {
+  SensorFrame frame;
+  frame.index = input.index;
+  frame.timestamp = input.timestamp;
+  frame.image = input.images[static_cast<std::size_t>(camera_)];
+  frame.image_right = input.images[static_cast<std::size_t>(camera_ + 1)];
+  frame.depth_image = input.depth;
+  frame.scan = input.scan;
+  return frame;
+}
+
+RunResult Pipeline::run(const Progress& progress) const {
+  System system(system_, calibration_, make_depth_source(), make_extractor());
+  RunResult out;
+  out.sequence_name = sequence_->name();
+  out.sequence_path = sequence_->path();
+  out.format = sequence_->format();
+  out.camera = camera_;
+  out.depth = depth_name_;
+  out.first = first_;
+  out.step = step_;
+  out.threaded = system_.threaded_mapping;
+
+  ReadAheadOptions read_options;
+  read_options.first = first_;
+  read_options.count = count_;
+  read_options.step = step_;
+  ReadAhead frames(*sequence_, read_options);
+  out.frames.reserve(count_);
+  Stopwatch wall;
+  for (;;) {
+    Stopwatch wait;
+    std::optional<FrameInput> input = frames.next();
+    const double wait_ms = wait.elapsed_ms();
+    if (!input) break;
+    FrameRecord record;
+    record.result = system.track(sensor_frame(*input));
+    record.io_wait_ms = wait_ms;
+    out.frames.push_back(record);
+    if (progress) progress(out.frames.back(), out.frames.size(), count_);
+  }
+  system.finish();
+  out.wall_s = wall.elapsed_ms() / 1000.0;
+  out.loop_closing = system.loop_closing();
+  out.loop_closures = system.loop_closures();  // threaded: some came after the last frame
+  out.loop_statistics = system.loop_statistics();
+
+  // Poses of cam0 (KITTI's reference camera) in the world of the ground truth when there is one (so
+  // that files line up with poses/NN.txt), else in the first frame's cam0.
+  const Eigen::Isometry3d T_cam_cam0 = calibration_.T_cam_cam0;
+  const auto& gt = sequence_->ground_truth();
+  Eigen::Isometry3d T_world_first = Eigen::Isometry3d::Identity();
+  if (gt && first_ < gt->size()) T_world_first = gt->poses[first_];
+  for (const auto& pose : system.trajectory()) {
+    out.trajectory.timestamps.push_back(pose.timestamp);
+    out.trajectory.poses.push_back(T_world_first * T_cam_cam0.inverse() * pose.T_world_cam * T_cam_cam0);
+  }
+  if (gt) {
+    for (std::size_t i = 0; i < out.trajectory.poses.size() && frame_index(i) < gt->size(); ++i) {
+      out.ground_truth.push_back(gt->poses[frame_index(i)]);
+    }
+  }
+  if (out.ground_truth.size() >= 2) {
+    RunMetrics metrics;
+    metrics.frames_with_ground_truth = out.ground_truth.size();
+    const std::span<const Eigen::Isometry3d> estimate(out.trajectory.poses.data(), out.ground_truth.size());
+    metrics.evaluation = evaluate_trajectory(estimate, out.ground_truth);
+    metrics.kitti_lengths = describe_lengths(metrics.evaluation.kitti_options);
+    out.metrics = std::move(metrics);
+  }
+
+  // the map, in the same world frame as the trajectory
+  const Map& map = system.map();
+  std::shared_lock lock(map.mutex());
+  const Eigen::Isometry3d T_out_world = T_world_first * T_cam_cam0.inverse();
+  for (const auto id : map.landmark_ids()) {
+    if (const Landmark* l = map.landmark(id)) out.landmarks.push_back(T_out_world * l->position);
+  }
+  for (const auto id : map.keyframe_ids()) {
+    if (const auto T_cam_world = map.keyframe_pose(id)) {
+      out.keyframes.push_back(T_out_world * T_cam_world->inverse() * T_cam_cam0);
+    }
+  }
+  return out;
+}
+
+std::size_t RunResult::count(TrackState state) const {
+  return static_cast<std::size_t>(
+      std::count_if(frames.begin(), frames.end(), [state](const FrameRecord& r) { return r.result.state == state; }));
+}
+
+std::size_t RunResult::keyframe_count() const {
+  return static_cast<std::size_t>(
+      std::count_if(frames.begin(), frames.end(), [](const FrameRecord& r) { return r.result.keyframe; }));
+}
+
+std::optional<int> RunResult::min_inliers_ok() const {
+  std::optional<int> fewest;
+  for (const auto& r : frames) {
+    if (r.result.state == TrackState::Ok) fewest = std::min(fewest.value_or(r.result.inliers), r.result.inliers);
+  }
+  return fewest;
+}
+
+StageStats stage_stats(std::vector<double> v) {
+  StageStats s;
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  const auto at = [&](double q) {
+    return v[static_cast<std::size_t>(std::min<double>(static_cast<double>(v.size() - 1),
+                                                        std::floor(q * static_cast<double>(v.size() - 1) + 0.5)))];
+  };
+  s.median = at(0.5);
+  s.p95 = at(0.95);
+  double sum = 0.0;
+  for (const double x : v) sum += x;
+  s.mean = sum / static_cast<double>(v.size());
+  s.max = v.back();
+  return s;
+}
+
+RunTimings RunResult::timings() const {
+  const auto stage = [this](auto&& ms) {
+    std::vector<double> v;
+    v.reserve(frames.size());
+    for (const auto& r : frames) v.push_back(ms(r));
+    return stage_stats(std::move(v));
+  };
+  RunTimings t;
+  t.io_wait = stage([](const FrameRecord& r) { return r.io_wait_ms; });
+  t.depth = stage([](const FrameRecord& r) { return r.result.timing.depth_ms; });
+  t.extraction = stage([](const FrameRecord& r) { return r.result.timing.extraction_ms; });
+  t.tracking = stage([](const FrameRecord& r) { return r.result.timing.tracking_ms; });
+  t.mapping = stage([](const FrameRecord& r) { return r.result.timing.mapping_ms; });
+  t.loop = stage([](const FrameRecord& r) { return r.result.timing.loop_ms; });
+  t.front = stage([](const FrameRecord& r) {
+    const auto& s = r.result.timing;
+    return s.depth_ms + s.extraction_ms + s.tracking_ms;
+  });
+  t.total = stage([](const FrameRecord& r) { return r.result.timing.total_ms; });
+  return t;
+}
+
+}  // namespace rgbl
