@@ -9,7 +9,7 @@
 #include "rgbl/depth/completion.hpp"
 #include "rgbl/depth/evaluation.hpp"
 #include "rgbl/depth/ip_basic.hpp"
-#include "rgbl/depth/registry.hpp"
+#include "rgbl/depth/sources.hpp"
 #include "rgbl/geometry/calibration.hpp"
 #include "rgbl/geometry/projection.hpp"
 #include "rgbl/io/trajectory_io.hpp"
@@ -97,10 +97,10 @@ int main(int argc, char** argv) try {
   Row stereo_row{"stereo SGBM (camera 0)", 0.0, {}, {}};
   double gt_density = 0.0, gt0_density = 0.0;
 
-  rgbl::DepthSourceSettings stereo_settings;
+  rgbl::DepthSourceContext stereo_settings;
   stereo_settings.calibration = cam0;
   stereo_settings.stereo_baseline = kitti.baseline(0, 1);
-  auto stereo = rgbl::DepthSourceRegistry::with_builtins().create("stereo", stereo_settings);
+  auto stereo = rgbl::make_stereo_source({}, stereo_settings);
 
   std::vector<cv::Mat_<float>> dense_buffers(kernels.size());
   for (auto& buffer : dense_buffers) buffer = cv::Mat_<float>(cam2.camera.height, cam2.camera.width, 0.0F);

@@ -2,7 +2,7 @@
 // `stereo_sparse` source (prepare + sample) against the straightforward full-resolution SAD search.
 #include "bench_data.hpp"
 #include "reference/stereo_sparse_reference.hpp"
-#include "rgbl/depth/registry.hpp"
+#include "rgbl/depth/sources.hpp"
 #include "rgbl/features/orb.hpp"
 
 #include <benchmark/benchmark.h>
@@ -35,9 +35,9 @@ std::vector<Eigen::Vector2f> orb_pixels(const cv::Mat& image) {
   return pixels;
 }
 
-rgbl::DepthSourceSettings stereo_settings() {
+rgbl::DepthSourceContext stereo_settings() {
   const auto kitti = rgbl::bench::calibration();
-  rgbl::DepthSourceSettings s;
+  rgbl::DepthSourceContext s;
   s.calibration = kitti.camera(0);
   s.stereo_baseline = kitti.baseline(0, 1);
   if (s.stereo_baseline <= 0.0) s.stereo_baseline = 0.54;
@@ -50,7 +50,7 @@ void stereo_sparse_rgbl(benchmark::State& state) {
   frame.image = rgbl::bench::gray_image(0);
   frame.image_right = right_image();
   const auto pixels = orb_pixels(frame.image);
-  auto source = rgbl::DepthSourceRegistry::with_builtins().create("stereo_sparse", stereo_settings());
+  auto source = rgbl::make_stereo_sparse_source({}, stereo_settings());
   std::vector<rgbl::KeypointDepth> out(pixels.size());
   for (auto _ : state) {
     source->prepare(frame);

@@ -106,17 +106,18 @@ int run_demo(const DemoArgs& args, bool quiet) {
     }
   }
 
-  // refuse what cannot work before spending the generation time on it
-  const std::string depth_name = args.depth.substr(0, args.depth.find(':'));
-  if (depth_name != "lidar" && depth_name != "stereo" && depth_name != "precomputed") {
+  // refuse what cannot work before spending the generation time on it (the layout has no depth camera)
+  const std::string spec = args.depth == "precomputed" ? "precomputed:exact" : args.depth;
+  const DepthSourceNeeds needs = builtin_depth_sources().entry(spec).needs;
+  if (needs.depth_image) {
     throw ConfigError("--depth", fmt::format("lidar[:...], stereo or precomputed[:<dir>] for the demo's KITTI layout "
-                                             "(it has no depth-camera images for rgbd; `precomputed` reads the "
-                                             "exact depth), not '{}'",
+                                             "(it has no depth-camera images; `precomputed` reads the exact depth), "
+                                             "not '{}'",
                                              args.depth));
   }
   // render only what tracking camera 0 with this depth source reads: the right image for stereo, the
   // exact depth for `precomputed` alone; the scan is always written (the KITTI layout's velodyne/)
-  sim.cameras = {true, depth_name == "stereo", false, false};
+  sim.cameras = {true, needs.right_image, false, false};
   sim.render_depth = args.depth == "precomputed";
   sim.validate();
 

@@ -95,7 +95,7 @@ Command add_depth_command(CLI::App& parent) {
             ScanWindow window(p.sequence(), *half_window);
             AccumulationOptions accumulation;
             accumulation.half_window = *half_window;
-            accumulation.projection = p.depth_settings().lidar.projection;
+            accumulation.projection = p.lidar_options().projection;
             DepthErrorAccumulator errors;
             double density_sum = 0.0, ms_sum = 0.0;
             std::size_t frames = 0, graded = 0;

@@ -9,6 +9,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <charconv>
+#include <system_error>
 #include <cmath>
 #include <limits>
 
@@ -50,8 +52,6 @@ void RgbdSourceOptions::validate() const {
   require(scale > 0.0 && std::isfinite(scale), "rgbd.scale", "a positive factor (units per metre, e.g. 5000)");
   require(max_depth > 0.0F, "rgbd.max_depth", "a depth > 0 m");
 }
-
-void DepthSourceSettings::validate() const { calibration.camera.validate(); }
 
 cv::Mat_<float> read_depth_png(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw ParseError(file, 0, "a depth PNG (uint16, depth x 256); the file does not exist");
@@ -118,9 +118,8 @@ float nearest_sample_distance(const cv::Mat_<float>& sparse, const Eigen::Vector
 
 class LidarDepthSource final : public DepthSource {
  public:
-  explicit LidarDepthSource(const DepthSourceSettings& settings)
-      : camera_(settings.calibration.camera), P_img_lidar_(settings.calibration.P_img_lidar()),
-        options_(settings.lidar) {
+  LidarDepthSource(const LidarSourceOptions& options, const DepthSourceContext& context)
+      : camera_(context.calibration.camera), P_img_lidar_(context.calibration.P_img_lidar()), options_(options) {
     options_.validate();
   }
 
@@ -188,8 +187,8 @@ class DenseDepthSource : public DepthSource {
 
 class PrecomputedDepthSource final : public DenseDepthSource {
  public:
-  explicit PrecomputedDepthSource(const DepthSourceSettings& settings)
-      : camera_(settings.calibration.camera), options_(settings.precomputed) {
+  PrecomputedDepthSource(const PrecomputedSourceOptions& options, const DepthSourceContext& context)
+      : camera_(context.calibration.camera), options_(options) {
     options_.validate();
   }
 
@@ -214,8 +213,8 @@ class PrecomputedDepthSource final : public DenseDepthSource {
 
 class StereoDepthSource final : public DenseDepthSource {
  public:
-  explicit StereoDepthSource(const DepthSourceSettings& settings)
-      : camera_(settings.calibration.camera), baseline_(settings.stereo_baseline), options_(settings.stereo) {
+  StereoDepthSource(const StereoSourceOptions& options, const DepthSourceContext& context)
+      : camera_(context.calibration.camera), baseline_(context.stereo_baseline), options_(options) {
     options_.validate();
     detail::require_stereo_baseline(baseline_);
     const int area = options_.block_size * options_.block_size;
@@ -256,8 +255,8 @@ class StereoDepthSource final : public DenseDepthSource {
 
 class RgbdDepthSource final : public DenseDepthSource {
  public:
-  explicit RgbdDepthSource(const DepthSourceSettings& settings)
-      : camera_(settings.calibration.camera), options_(settings.rgbd) {
+  RgbdDepthSource(const RgbdSourceOptions& options, const DepthSourceContext& context)
+      : camera_(context.calibration.camera), options_(options) {
     options_.validate();
   }
 
@@ -287,17 +286,122 @@ class RgbdDepthSource final : public DenseDepthSource {
 
 }  // namespace
 
-std::unique_ptr<DepthSource> make_lidar_source(const DepthSourceSettings& settings) {
-  return std::make_unique<LidarDepthSource>(settings);
+std::unique_ptr<DepthSource> make_lidar_source(const LidarSourceOptions& options, const DepthSourceContext& context) {
+  return std::make_unique<LidarDepthSource>(options, context);
 }
-std::unique_ptr<DepthSource> make_precomputed_source(const DepthSourceSettings& settings) {
-  return std::make_unique<PrecomputedDepthSource>(settings);
+std::unique_ptr<DepthSource> make_precomputed_source(const PrecomputedSourceOptions& options,
+                                                     const DepthSourceContext& context) {
+  return std::make_unique<PrecomputedDepthSource>(options, context);
 }
-std::unique_ptr<DepthSource> make_stereo_source(const DepthSourceSettings& settings) {
-  return std::make_unique<StereoDepthSource>(settings);
+std::unique_ptr<DepthSource> make_stereo_source(const StereoSourceOptions& options, const DepthSourceContext& context) {
+  return std::make_unique<StereoDepthSource>(options, context);
 }
-std::unique_ptr<DepthSource> make_rgbd_source(const DepthSourceSettings& settings) {
-  return std::make_unique<RgbdDepthSource>(settings);
+std::unique_ptr<DepthSource> make_rgbd_source(const RgbdSourceOptions& options, const DepthSourceContext& context) {
+  return std::make_unique<RgbdDepthSource>(options, context);
+}
+
+void apply_lidar_argument(std::string_view argument, LidarSourceOptions& options) {
+  const std::string arg(argument);
+  if (arg.empty() || arg == "dilation") return;
+  if (arg == "dilated") {
+    options.keypoint_depth = KeypointDepthRule::dilated;  // the paper's keypoint depth: the dense map's value
+  } else if (arg == "ipbasic" || arg == "ipbasic-fast") {
+    options.completion = CompletionMethod::ip_basic_fast;
+  } else if (arg == "ipbasic-multiscale") {
+    options.completion = CompletionMethod::ip_basic_multiscale;
+  } else {
+    // <shape><size>, e.g. diamond5, rectangle3, cross7
+    const auto digit = arg.find_first_of("0123456789");
+    if (digit == std::string::npos || digit == 0) {
+      throw ConfigError("--depth", fmt::format("lidar, lidar:dilated, lidar:ipbasic, lidar:ipbasic-multiscale or "
+                                               "lidar:<diamond|rectangle|cross><size>, not 'lidar:{}'",
+                                               arg));
+    }
+    try {
+      options.dilation.shape = parse_kernel_shape(arg.substr(0, digit), "--depth");
+    } catch (const ConfigError&) {
+      throw ConfigError("--depth", fmt::format("a kernel shape diamond, rectangle or cross (e.g. lidar:diamond5), "
+                                               "not 'lidar:{}'", arg));
+    }
+    // std::stoi would accept "7x" and throw a bare "stoi" on overflow: parse the whole tail.
+    const std::string size = arg.substr(digit);
+    int value = 0;
+    const auto [end, ec] = std::from_chars(size.data(), size.data() + size.size(), value);
+    if (ec != std::errc() || end != size.data() + size.size() || value < 1 || value > 63 || value % 2 == 0) {
+      throw ConfigError("--depth", fmt::format("an odd kernel size 1..63 after the shape (e.g. lidar:diamond5), "
+                                               "not 'lidar:{}'", arg));
+    }
+    options.dilation.size = value;
+  }
+}
+
+namespace {
+
+// An entry for a source that takes no argument.
+template <typename Options, typename Make>
+DepthSourceEntry plain_entry(const char* name, DepthSourceNeeds needs, Options options, Make make) {
+  return {needs, name, [name, options, make](std::string_view argument, const DepthSourceContext& context) {
+            if (!argument.empty()) throw ConfigError("--depth", fmt::format("'{}' without an argument", name));
+            return make(options, context);
+          }};
+}
+
+}  // namespace
+
+DepthSourceEntry lidar_depth_source(LidarSourceOptions options) {
+  DepthSourceNeeds needs;
+  needs.scan = true;
+  return {needs, "lidar[:dilated|ipbasic|ipbasic-multiscale|<diamond|rectangle|cross><size>]",
+          [options](std::string_view argument, const DepthSourceContext& context) {
+            LidarSourceOptions o = options;
+            apply_lidar_argument(argument, o);
+            return make_lidar_source(o, context);
+          }};
+}
+
+DepthSourceEntry precomputed_depth_source(PrecomputedSourceOptions options) {
+  return {{}, "precomputed:<folder of uint16 depth PNGs>",
+          [options](std::string_view argument, const DepthSourceContext& context) {
+            PrecomputedSourceOptions o = options;
+            if (!argument.empty()) o.folder = std::string(argument);
+            if (o.folder.empty()) throw ConfigError("--depth", "precomputed:<folder of uint16 depth PNGs>");
+            return make_precomputed_source(o, context);
+          }};
+}
+
+DepthSourceEntry stereo_depth_source(StereoSourceOptions options) {
+  DepthSourceNeeds needs;
+  needs.right_image = true;
+  return plain_entry("stereo", needs, options, [](const StereoSourceOptions& o, const DepthSourceContext& c) {
+    return make_stereo_source(o, c);
+  });
+}
+
+DepthSourceEntry stereo_sparse_depth_source(StereoSparseSourceOptions options) {
+  DepthSourceNeeds needs;
+  needs.right_image = true;
+  return plain_entry("stereo_sparse", needs, options,
+                     [](const StereoSparseSourceOptions& o, const DepthSourceContext& c) {
+                       return make_stereo_sparse_source(o, c);
+                     });
+}
+
+DepthSourceEntry rgbd_depth_source(RgbdSourceOptions options) {
+  DepthSourceNeeds needs;
+  needs.depth_image = true;
+  return plain_entry("rgbd", needs, options, [](const RgbdSourceOptions& o, const DepthSourceContext& c) {
+    return make_rgbd_source(o, c);
+  });
+}
+
+DepthSourceRegistry builtin_depth_sources() {
+  DepthSourceRegistry registry;
+  registry.add("lidar", lidar_depth_source());
+  registry.add("precomputed", precomputed_depth_source());
+  registry.add("stereo", stereo_depth_source());
+  registry.add("stereo_sparse", stereo_sparse_depth_source());
+  registry.add("rgbd", rgbd_depth_source());
+  return registry;
 }
 
 }  // namespace rgbl

@@ -86,8 +86,8 @@ float texture(const cv::Mat& image, int x, int y, int half) {
 
 class StereoSparseDepthSource final : public DepthSource {
  public:
-  explicit StereoSparseDepthSource(const DepthSourceSettings& settings)
-      : camera_(settings.calibration.camera), baseline_(settings.stereo_baseline), options_(settings.stereo_sparse) {
+  StereoSparseDepthSource(const StereoSparseSourceOptions& options, const DepthSourceContext& context)
+      : camera_(context.calibration.camera), baseline_(context.stereo_baseline), options_(options) {
     options_.validate();
     detail::require_stereo_baseline(baseline_);
     fb_ = static_cast<float>(camera_.fx * baseline_);
@@ -221,8 +221,9 @@ class StereoSparseDepthSource final : public DepthSource {
 
 }  // namespace
 
-std::unique_ptr<DepthSource> make_stereo_sparse_source(const DepthSourceSettings& settings) {
-  return std::make_unique<StereoSparseDepthSource>(settings);
+std::unique_ptr<DepthSource> make_stereo_sparse_source(const StereoSparseSourceOptions& options,
+                                                       const DepthSourceContext& context) {
+  return std::make_unique<StereoSparseDepthSource>(options, context);
 }
 
 }  // namespace rgbl

@@ -2,6 +2,7 @@
 
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/timer.hpp"
+#include "rgbl/depth/sources.hpp"
 #include "rgbl/io/read_ahead.hpp"
 #include "rgbl/io/settings.hpp"
 
@@ -9,63 +10,17 @@
 
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <mutex>
 #include <shared_mutex>
-#include <system_error>
 
 namespace rgbl {
 namespace {
 
-// name[:argument] of --depth: lidar | lidar:dilated | lidar:ipbasic | lidar:ipbasic-multiscale |
-// lidar:<kernel><size> (e.g. lidar:diamond7) | precomputed:<dir> | stereo | stereo_sparse | rgbd
-void apply_depth_spec(const std::string& spec, const DepthSourceRegistry& registry, std::string& name,
-                      DepthSourceSettings& settings) {
-  const auto colon = spec.find(':');
-  name = spec.substr(0, colon);
-  const std::string arg = colon == std::string::npos ? std::string() : spec.substr(colon + 1);
-  auto& lidar = settings.lidar;
-  if (name == "lidar") {
-    if (arg.empty() || arg == "dilation") return;
-    if (arg == "dilated") {
-      lidar.keypoint_depth = KeypointDepthRule::dilated;  // the paper's keypoint depth: the dense map's value
-    } else if (arg == "ipbasic" || arg == "ipbasic-fast") {
-      lidar.completion = CompletionMethod::ip_basic_fast;
-    } else if (arg == "ipbasic-multiscale") {
-      lidar.completion = CompletionMethod::ip_basic_multiscale;
-    } else {
-      // <shape><size>, e.g. diamond5, rectangle3, cross7
-      const auto digit = arg.find_first_of("0123456789");
-      if (digit == std::string::npos || digit == 0) {
-        throw ConfigError("--depth", fmt::format("lidar, lidar:dilated, lidar:ipbasic, lidar:ipbasic-multiscale or "
-                                                 "lidar:<diamond|rectangle|cross><size>, not '{}'",
-                                                 spec));
-      }
-      lidar.dilation.shape = parse_kernel_shape(arg.substr(0, digit), "--depth");
-      // std::stoi would accept "7x" and throw a bare "stoi" on overflow: parse the whole tail.
-      const std::string size = arg.substr(digit);
-      int value = 0;
-      const auto [end, ec] = std::from_chars(size.data(), size.data() + size.size(), value);
-      if (ec != std::errc() || end != size.data() + size.size() || value < 1 || value > 63 || value % 2 == 0) {
-        throw ConfigError("--depth", fmt::format("an odd kernel size 1..63 after the shape (e.g. lidar:diamond5), "
-                                                 "not '{}'", spec));
-      }
-      lidar.dilation.size = value;
-    }
-  } else if (name == "precomputed") {
-    if (arg.empty()) throw ConfigError("--depth", "precomputed:<folder of uint16 depth PNGs>");
-    settings.precomputed.folder = arg;
-  } else if (name == "stereo" || name == "stereo_sparse" || name == "rgbd") {
-    if (!arg.empty()) throw ConfigError("--depth", fmt::format("'{}' without an argument", name));
-  } else if (!registry.contains(name)) {
-    throw ConfigError("--depth", fmt::format("one of lidar[:...], precomputed:<dir>, stereo, stereo_sparse, rgbd; not '{}'", spec));
-  }
-}
-
 struct Resolved {
   CameraCalibration& calibration;
-  DepthSourceSettings& depth;
+  LidarSourceOptions& lidar;
+  RgbdSourceOptions& rgbd;
   SystemOptions& system;
   OrbOptions& orb;
   std::vector<std::string>& notes;
@@ -80,8 +35,8 @@ void apply_settings(const Settings& s, Resolved p) {
   p.orb.fast_min_threshold = s.orb.min_th_fast;
   if (s.orb.features_per_node) p.orb.features_per_node = *s.orb.features_per_node;
   if (s.orb.spread_fraction) p.orb.spread_fraction = *s.orb.spread_fraction;
-  p.depth.lidar.projection = s.projection;
-  p.depth.lidar.dilation.max_depth = s.projection.max_depth;
+  p.lidar.projection = s.projection;
+  p.lidar.dilation.max_depth = s.projection.max_depth;
   if (!s.lidar_method.empty() && s.lidar_method != "InverseDilation") {
     throw ConfigError("LiDAR.Method", fmt::format("InverseDilation (the only method of the reference settings "
                                                   "rgbl maps; use --depth lidar:ipbasic for IP-Basic), not '{}'",
@@ -90,9 +45,9 @@ void apply_settings(const Settings& s, Resolved p) {
   if (!s.kernel_type.empty()) {
     std::string shape = s.kernel_type;
     for (auto& c : shape) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    p.depth.lidar.dilation.shape = parse_kernel_shape(shape, "LiDAR.MethodInverseDilation.KernelType");
+    p.lidar.dilation.shape = parse_kernel_shape(shape, "LiDAR.MethodInverseDilation.KernelType");
   }
-  if (s.kernel_size > 0) p.depth.lidar.dilation.size = s.kernel_size;
+  if (s.kernel_size > 0) p.lidar.dilation.size = s.kernel_size;
   if (s.T_cam_lidar) {
     p.calibration.T_cam_lidar = *s.T_cam_lidar;
     p.notes.push_back(fmt::format("{}: LiDAR.Tr overrides the dataset's LiDAR extrinsics", s.file.string()));
@@ -107,7 +62,7 @@ void apply_settings(const Settings& s, Resolved p) {
                                     s.file.string()));
     }
   }
-  if (s.depth_map_factor) p.depth.rgbd.scale = *s.depth_map_factor;
+  if (s.depth_map_factor) p.rgbd.scale = *s.depth_map_factor;
   LoopClosingOptions& loop = p.system.loop_closing;
   const LoopClosingSettings& l = s.loop_closing;
   if (l.enabled) loop.enabled = *l.enabled;
@@ -149,34 +104,39 @@ Pipeline::Pipeline(const PipelineOptions& options, const DepthSourceRegistry& re
                                               sequence_->path().string(), camera_));
   }
   const KittiCalibration& kitti = sequence_->calibration();
-  calibration_ = kitti.camera(camera_);
+  context_.calibration = kitti.camera(camera_);
   if (sensors.cameras[static_cast<std::size_t>(camera_ + 1)]) {
-    depth_settings_.stereo_baseline = kitti.baseline(camera_, camera_ + 1);
+    context_.stereo_baseline = kitti.baseline(camera_, camera_ + 1);
   }
-  apply_depth_spec(options_.depth, registry_, depth_name_, depth_settings_);
   if (!options_.settings.empty()) {
     const Settings settings = read_settings(options_.settings);
+    RgbdSourceOptions rgbd;
     try {
-      apply_settings(settings, {calibration_, depth_settings_, system_, orb_, notes_});
+      apply_settings(settings, {context_.calibration, lidar_, rgbd, system_, orb_, notes_});
     } catch (const ConfigError& e) {
       throw ParseError(settings.file, 0, e.what());  // name the settings file, not just the key
     }
+    // the settings file's LiDAR.* keys and DepthMapFactor are the built-ins' starting options
+    registry_.add("lidar", lidar_depth_source(lidar_));
+    registry_.add("rgbd", rgbd_depth_source(rgbd));
   }
-  depth_settings_.calibration = calibration_;
   system_.threaded_mapping = options_.threaded;
   if (!options_.loop_closing) system_.loop_closing.enabled = false;
 
-  if (depth_name_ == "lidar" && !sensors.lidar) {
-    throw ConfigError("--depth", fmt::format("a source the dataset has: {} has no LiDAR scans (try stereo or rgbd)",
-                                             sequence_->path().string()));
+  // the dataset must have what the source reads, before any frame is read
+  const DepthSourceEntry& entry = registry_.entry(options_.depth);
+  depth_name_ = std::string(split_depth_spec(options_.depth).first);
+  const std::string& where = sequence_->path().string();
+  if (entry.needs.scan && !sensors.lidar) {
+    throw ConfigError("--depth", fmt::format("a source the dataset has: {} has no LiDAR scans for '{}' (try stereo or "
+                                             "rgbd)", where, depth_name_));
   }
-  if ((depth_name_ == "stereo" || depth_name_ == "stereo_sparse") &&
-      !sensors.cameras[static_cast<std::size_t>(camera_ + 1)]) {
+  if (entry.needs.right_image && !sensors.cameras[static_cast<std::size_t>(camera_ + 1)]) {
     throw ConfigError("--depth", fmt::format("{} needs camera {} (image_{}) next to camera {}", depth_name_,
                                              camera_ + 1, camera_ + 1, camera_));
   }
-  if (depth_name_ == "rgbd" && !sensors.depth) {
-    throw ConfigError("--depth", fmt::format("rgbd needs depth images: {} has none", sequence_->path().string()));
+  if (entry.needs.depth_image && !sensors.depth) {
+    throw ConfigError("--depth", fmt::format("{} needs depth images: {} has none", depth_name_, where));
   }
   const std::size_t size = sequence_->size();
   if (options_.first >= size) {
@@ -192,9 +152,7 @@ Pipeline::Pipeline(const PipelineOptions& options, const DepthSourceRegistry& re
   (void)make_depth_source();
 }
 
-std::unique_ptr<DepthSource> Pipeline::make_depth_source() const {
-  return registry_.create(depth_name_, depth_settings_);
-}
+std::unique_ptr<DepthSource> Pipeline::make_depth_source() const { return registry_.create(options_.depth, context_); }
 
 FeatureExtractor Pipeline::make_extractor() const {
   auto extractor = std::make_shared<OrbExtractor>(orb_);
@@ -215,7 +173,7 @@ SensorFrame Pipeline::sensor_frame(const FrameInput& input) const {
 }
 
 RunResult Pipeline::run(const Progress& progress) const {
-  System system(system_, calibration_, make_depth_source(), make_extractor());
+  System system(system_, context_.calibration, make_depth_source(), make_extractor());
   RunResult out;
   out.sequence_name = sequence_->name();
   out.sequence_path = sequence_->path();
@@ -252,7 +210,7 @@ RunResult Pipeline::run(const Progress& progress) const {
 
   // Poses of cam0 (KITTI's reference camera) in the world of the ground truth when there is one (so
   // that files line up with poses/NN.txt), else in the first frame's cam0.
-  const Eigen::Isometry3d T_cam_cam0 = calibration_.T_cam_cam0;
+  const Eigen::Isometry3d T_cam_cam0 = context_.calibration.T_cam_cam0;
   const auto& gt = sequence_->ground_truth();
   Eigen::Isometry3d T_world_first = Eigen::Isometry3d::Identity();
   if (gt && first_ < gt->size()) T_world_first = gt->poses[first_];

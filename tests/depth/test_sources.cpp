@@ -1,6 +1,6 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/depth/completion.hpp"
-#include "rgbl/depth/registry.hpp"
+#include "rgbl/depth/sources.hpp"
 #include "rgbl/geometry/calibration.hpp"
 #include "support/data.hpp"
 #include "support/temp_dir.hpp"
@@ -16,20 +16,25 @@ using Catch::Matchers::Contains;
 namespace {
 
 // LiDAR frame == camera frame, f = 100 px, 64x48 image, principal point (32, 24).
-rgbl::DepthSourceSettings simple_settings() {
-  rgbl::DepthSourceSettings s;
+rgbl::DepthSourceContext simple_settings() {
+  rgbl::DepthSourceContext s;
   s.calibration.camera.fx = s.calibration.camera.fy = 100.0;
   s.calibration.camera.cx = 32.0;
   s.calibration.camera.cy = 24.0;
   s.calibration.camera.width = 64;
   s.calibration.camera.height = 48;
-  s.lidar.projection.min_depth = 1.0F;
   return s;
 }
 
-rgbl::DepthSourceSettings kitti_settings(const std::filesystem::path& seq) {
+rgbl::LidarSourceOptions simple_lidar() {
+  rgbl::LidarSourceOptions o;
+  o.projection.min_depth = 1.0F;
+  return o;
+}
+
+rgbl::DepthSourceContext kitti_settings(const std::filesystem::path& seq) {
   const auto kitti = rgbl::read_kitti_odometry_calibration(seq / "calib.txt", 1226, 370);
-  rgbl::DepthSourceSettings s;
+  rgbl::DepthSourceContext s;
   s.calibration = kitti.camera(2);
   s.stereo_baseline = kitti.baseline(2, 3);
   return s;
@@ -52,16 +57,26 @@ class ConstantSource final : public rgbl::DepthSource {
 }  // namespace
 
 TEST_CASE("registry: built-ins, unknown names and user sources") {
-  auto registry = rgbl::DepthSourceRegistry::with_builtins();
+  auto registry = rgbl::builtin_depth_sources();
   CHECK(registry.names() == std::vector<std::string>{"lidar", "precomputed", "rgbd", "stereo", "stereo_sparse"});
   try {
     (void)registry.create("neural", simple_settings());
     FAIL("expected a ConfigError");
   } catch (const rgbl::ConfigError& e) {
-    CHECK(e.key() == "depth.source");
-    CHECK_THAT(e.what(), Contains("lidar, precomputed, rgbd, stereo, stereo_sparse") && Contains("neural"));
+    CHECK(e.key() == "--depth");
+    CHECK_THAT(e.what(), Contains("lidar[:") && Contains("precomputed:<") && Contains("stereo_sparse") &&
+                             Contains("'neural'"));
   }
-  registry.add("constant", [](const rgbl::DepthSourceSettings&) { return std::make_unique<ConstantSource>(4.0F); });
+  // what each built-in reads from a frame
+  CHECK(registry.entry("lidar:diamond7").needs.scan);
+  CHECK(registry.entry("rgbd").needs.depth_image);
+  CHECK(registry.entry("stereo").needs.right_image);
+  CHECK_FALSE(registry.entry("precomputed:x").needs.scan);
+  // a user source with its own option in the argument
+  registry.add("constant", {{}, "constant[:<metres>]", [](std::string_view arg, const rgbl::DepthSourceContext&) {
+                              return std::make_unique<ConstantSource>(arg.empty() ? 4.0F : std::stof(std::string(arg)));
+                            }});
+  CHECK(registry.create("constant:2.5", simple_settings())->name() == "constant");
   auto source = registry.create("constant", simple_settings());
   REQUIRE(source != nullptr);
   CHECK(source->name() == "constant");
@@ -70,14 +85,18 @@ TEST_CASE("registry: built-ins, unknown names and user sources") {
   source->sample(pixels, out);
   CHECK(out[0].z == 4.0F);
   CHECK_THROWS_AS(registry.add("", {}), rgbl::ConfigError);
+  CHECK_THROWS_AS(registry.add("a:b", rgbl::lidar_depth_source()), rgbl::ConfigError);
+  CHECK_THROWS_WITH(registry.create("lidar:hexagon3", simple_settings()), Contains("--depth") && Contains("hexagon3"));
+  CHECK_THROWS_WITH(registry.create("lidar:diamond4", simple_settings()), Contains("odd kernel size"));
+  CHECK_THROWS_WITH(registry.create("precomputed", simple_settings()), Contains("precomputed:<folder"));
+  CHECK_THROWS_WITH(registry.create("rgbd:x", simple_settings()), Contains("without an argument"));
   auto bad = simple_settings();
   bad.calibration.camera.fx = 0.0;
   CHECK_THROWS_AS(registry.create("lidar", bad), rgbl::ConfigError);
 }
 
 TEST_CASE("lidar source: projects, samples keypoints and agrees with its dense map") {
-  const auto registry = rgbl::DepthSourceRegistry::with_builtins();
-  auto source = registry.create("lidar", simple_settings());
+  auto source = rgbl::make_lidar_source(simple_lidar(), simple_settings());
   CHECK(source->name() == "lidar");
   {
     // A dropped scan (empty) is no depth anywhere, not an error that would stop a run.
@@ -121,8 +140,8 @@ TEST_CASE("lidar source on real frames: keypoint samples equal the dense map (di
   for (int y = 0; y < height; y += 3)
     for (int x = 0; x < width; x += 2) pixels.emplace_back(static_cast<float>(x) + 0.3F, static_cast<float>(y) - 0.4F);
   auto sample = [&](rgbl::KeypointDepthRule rule, cv::Mat_<float>& dense) {
-    settings.lidar.keypoint_depth = rule;
-    auto source = rgbl::DepthSourceRegistry::with_builtins().create("lidar", settings);
+    auto source = rgbl::builtin_depth_sources().create(
+        rule == rgbl::KeypointDepthRule::dilated ? "lidar:dilated" : "lidar", settings);
     source->prepare(frame);
     dense = source->dense_depth();
     std::vector<rgbl::KeypointDepth> out(pixels.size());
@@ -161,14 +180,15 @@ TEST_CASE("lidar source on real frames: keypoint samples equal the dense map (di
 TEST_CASE("precomputed source: reads PNGs, drops the top fraction and far depths, names missing files") {
   rgbl::test::TempDir dir;
   auto settings = simple_settings();
-  settings.precomputed.folder = dir.path();
-  settings.precomputed.ignore_top_fraction = 0.25;  // 12 of 48 rows
-  settings.precomputed.max_depth = 50.0F;
+  rgbl::PrecomputedSourceOptions precomputed;
+  precomputed.folder = dir.path();
+  precomputed.ignore_top_fraction = 0.25;  // 12 of 48 rows
+  precomputed.max_depth = 50.0F;
   cv::Mat_<float> depth(48, 64, 10.5F);
   depth(30, 10) = 60.0F;  // beyond the cap
   depth(30, 11) = 0.0F;
   rgbl::write_depth_png(dir.path() / "000007.png", depth);
-  auto source = rgbl::DepthSourceRegistry::with_builtins().create("precomputed", settings);
+  auto source = rgbl::make_precomputed_source(precomputed, settings);
   rgbl::SensorFrame frame;
   frame.index = 7;
   source->prepare(frame);
@@ -190,19 +210,20 @@ TEST_CASE("precomputed source: reads PNGs, drops the top fraction and far depths
   rgbl::write_depth_png(dir.path() / "000009.png", cv::Mat_<float>(10, 10, 1.0F));
   frame.index = 9;
   CHECK_THROWS_WITH(source->prepare(frame), Contains("000009.png") && Contains("64x48"));
-  settings.precomputed.ignore_top_fraction = 1.0;
-  CHECK_THROWS_WITH(rgbl::DepthSourceRegistry::with_builtins().create("precomputed", settings),
-                    Contains("precomputed.ignore_top_fraction"));
-  settings.precomputed.folder.clear();
-  settings.precomputed.ignore_top_fraction = 0.0;
-  CHECK_THROWS_WITH(rgbl::DepthSourceRegistry::with_builtins().create("precomputed", settings),
-                    Contains("precomputed.folder"));
+  precomputed.ignore_top_fraction = 1.0;
+  CHECK_THROWS_WITH(rgbl::make_precomputed_source(precomputed, settings), Contains("precomputed.ignore_top_fraction"));
+  precomputed.folder.clear();
+  precomputed.ignore_top_fraction = 0.0;
+  CHECK_THROWS_WITH(rgbl::make_precomputed_source(precomputed, settings), Contains("precomputed.folder"));
+  // by name the argument is the folder
+  CHECK(rgbl::builtin_depth_sources().create("precomputed:" + dir.path().string(), settings)->name() == "precomputed");
 }
 
 TEST_CASE("rgbd source: scaled uint16 or float metres, bad input named") {
   auto settings = simple_settings();
-  settings.rgbd.scale = 5000.0;
-  auto source = rgbl::DepthSourceRegistry::with_builtins().create("rgbd", settings);
+  rgbl::RgbdSourceOptions rgbd;
+  rgbd.scale = 5000.0;
+  auto source = rgbl::make_rgbd_source(rgbd, settings);
   rgbl::SensorFrame frame;
   CHECK_THROWS_WITH(source->prepare(frame), Contains("frame.depth_image"));
   cv::Mat raw(48, 64, CV_16UC1, cv::Scalar(10000));  // 2 m at 5000 per metre
@@ -224,18 +245,19 @@ TEST_CASE("rgbd source: scaled uint16 or float metres, bad input named") {
   CHECK_THROWS_WITH(source->prepare(frame), Contains("CV_16UC1"));
   frame.depth_image = cv::Mat(10, 10, CV_16UC1, cv::Scalar(1));
   CHECK_THROWS_WITH(source->prepare(frame), Contains("64x48"));
-  settings.rgbd.scale = 0.0;
-  CHECK_THROWS_WITH(rgbl::DepthSourceRegistry::with_builtins().create("rgbd", settings), Contains("rgbd.scale"));
+  rgbd.scale = 0.0;
+  CHECK_THROWS_WITH(rgbl::make_rgbd_source(rgbd, settings), Contains("rgbd.scale"));
 }
 
 TEST_CASE("stereo source: depth = fx * baseline / disparity on a shifted texture") {
   auto settings = simple_settings();
-  CHECK_THROWS_WITH(rgbl::DepthSourceRegistry::with_builtins().create("stereo", settings), Contains("stereo_baseline"));
+  CHECK_THROWS_WITH(rgbl::builtin_depth_sources().create("stereo", settings), Contains("stereo_baseline"));
   settings.calibration.camera.width = 160;
   settings.calibration.camera.height = 80;
   settings.stereo_baseline = 0.5;
-  settings.stereo.num_disparities = 16;
-  auto source = rgbl::DepthSourceRegistry::with_builtins().create("stereo", settings);
+  rgbl::StereoSourceOptions stereo;
+  stereo.num_disparities = 16;
+  auto source = rgbl::make_stereo_source(stereo, settings);
   rgbl::SensorFrame frame;
   CHECK_THROWS_WITH(source->prepare(frame), Contains("image_right"));
   // a random texture seen 8 px further left in the right image: disparity 8, z = 100 * 0.5 / 8
@@ -256,9 +278,10 @@ TEST_CASE("stereo source: depth = fx * baseline / disparity on a shifted texture
 
 TEST_CASE("lidar source with IP-Basic completion samples its dense map") {
   auto settings = simple_settings();
-  settings.lidar.completion = rgbl::parse_completion_method("ip_basic_fast");
+  auto lidar = simple_lidar();
+  lidar.completion = rgbl::parse_completion_method("ip_basic_fast");
   CHECK_THROWS_WITH(rgbl::parse_completion_method("neural"), Contains("lidar.completion"));
-  auto source = rgbl::DepthSourceRegistry::with_builtins().create("lidar", settings);
+  auto source = rgbl::make_lidar_source(lidar, settings);
   std::vector<rgbl::LidarPoint> scan;
   for (int y = -20; y <= 20; y += 4)
     for (int x = -30; x <= 30; x += 4) scan.push_back({static_cast<float>(x) * 0.2F, static_cast<float>(y) * 0.2F, 20.0F, 0.0F});

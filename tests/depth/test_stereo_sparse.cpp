@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "rgbl/core/error.hpp"
-#include "rgbl/depth/registry.hpp"
+#include "rgbl/depth/sources.hpp"
 #include "rgbl/geometry/calibration.hpp"
 #include "support/data.hpp"
 
@@ -19,8 +19,8 @@ namespace {
 constexpr int kWidth = 320, kHeight = 120;
 constexpr double kFx = 100.0, kBaseline = 0.5;  // fx * b = 50 px m
 
-rgbl::DepthSourceSettings settings() {
-  rgbl::DepthSourceSettings s;
+rgbl::DepthSourceContext settings() {
+  rgbl::DepthSourceContext s;
   s.calibration.camera.fx = s.calibration.camera.fy = kFx;
   s.calibration.camera.cx = kWidth / 2.0;
   s.calibration.camera.cy = kHeight / 2.0;
@@ -63,7 +63,7 @@ float disparity_of(const rgbl::KeypointDepth& d) { return static_cast<float>(kFx
 }  // namespace
 
 TEST_CASE("stereo_sparse: created by name, options validated") {
-  const auto registry = rgbl::DepthSourceRegistry::with_builtins();
+  const auto registry = rgbl::builtin_depth_sources();
   REQUIRE(registry.contains("stereo_sparse"));
   auto source = registry.create("stereo_sparse", settings());
   CHECK(source->name() == "stereo_sparse");
@@ -71,23 +71,28 @@ TEST_CASE("stereo_sparse: created by name, options validated") {
   auto s = settings();
   s.stereo_baseline = 0.0;
   CHECK_THROWS_WITH(registry.create("stereo_sparse", s), Contains("stereo_baseline"));
-  s = settings();
-  s.stereo_sparse.window = 10;
-  CHECK_THROWS_WITH(registry.create("stereo_sparse", s), Contains("stereo_sparse.window"));
-  s = settings();
-  s.stereo_sparse.max_disparity = 2;
-  CHECK_THROWS_WITH(registry.create("stereo_sparse", s), Contains("stereo_sparse.max_disparity"));
-  s = settings();
-  s.stereo_sparse.uniqueness_ratio = 100;
-  CHECK_THROWS_WITH(registry.create("stereo_sparse", s), Contains("stereo_sparse.uniqueness_ratio"));
-  // the other sources' options are not this source's business
-  s = settings();
-  s.stereo.block_size = 4;
-  CHECK_NOTHROW(registry.create("stereo_sparse", s));
+  CHECK_THROWS_WITH(registry.create("stereo_sparse:fast", settings()), Contains("without an argument"));
+  const auto bad = [](auto change) {
+    rgbl::StereoSparseSourceOptions o;
+    change(o);
+    return o;
+  };
+  CHECK_THROWS_WITH(rgbl::make_stereo_sparse_source(bad([](auto& o) { o.window = 10; }), settings()),
+                    Contains("stereo_sparse.window"));
+  CHECK_THROWS_WITH(rgbl::make_stereo_sparse_source(bad([](auto& o) { o.max_disparity = 2; }), settings()),
+                    Contains("stereo_sparse.max_disparity"));
+  CHECK_THROWS_WITH(rgbl::make_stereo_sparse_source(bad([](auto& o) { o.uniqueness_ratio = 100; }), settings()),
+                    Contains("stereo_sparse.uniqueness_ratio"));
+  // a registry entry starts from its options
+  auto with_options = rgbl::builtin_depth_sources();
+  with_options.add("stereo_sparse", rgbl::stereo_sparse_depth_source(bad([](auto& o) { o.window = 10; })));
+  CHECK_THROWS_WITH(with_options.create("stereo_sparse", settings()), Contains("stereo_sparse.window"));
+  CHECK(with_options.entry("stereo_sparse").needs.right_image);
+  CHECK_FALSE(with_options.entry("stereo_sparse").needs.scan);
 }
 
 TEST_CASE("stereo_sparse: exact disparity on a shifted texture") {
-  auto source = rgbl::DepthSourceRegistry::with_builtins().create("stereo_sparse", settings());
+  auto source = rgbl::builtin_depth_sources().create("stereo_sparse", settings());
   const cv::Mat tex = texture(kWidth + 200, kHeight, 5);
   std::vector<Eigen::Vector2f> pixels;
   for (int y = 12; y < kHeight - 12; y += 9) {
@@ -119,7 +124,7 @@ TEST_CASE("stereo_sparse: exact disparity on a shifted texture") {
 }
 
 TEST_CASE("stereo_sparse: no depth on flat or repetitive patches, near borders or beyond the range") {
-  auto source = rgbl::DepthSourceRegistry::with_builtins().create("stereo_sparse", settings());
+  auto source = rgbl::builtin_depth_sources().create("stereo_sparse", settings());
   cv::Mat tex = texture(kWidth + 200, kHeight, 9);
   tex(cv::Rect(40 + 150, 20, 80, 60)).setTo(128.0F);  // flat in the left image and in the right
   for (int x = 40 + 240; x < 40 + 300; ++x) tex.col(x).setTo(x % 6 < 3 ? 60.0F : 190.0F);  // stripes, period 6
@@ -152,7 +157,7 @@ TEST_CASE("stereo_sparse: no depth on flat or repetitive patches, near borders o
 }
 
 TEST_CASE("stereo_sparse: bad input is named") {
-  auto source = rgbl::DepthSourceRegistry::with_builtins().create("stereo_sparse", settings());
+  auto source = rgbl::builtin_depth_sources().create("stereo_sparse", settings());
   const rgbl::SensorFrame pair = shifted_pair(texture(kWidth + 200, kHeight, 3), 10.0);
   rgbl::SensorFrame frame;
   frame.image = pair.image;
@@ -181,11 +186,11 @@ TEST_CASE("stereo_sparse on real KITTI frames: exact on a shifted real image, cl
   const auto seq = rgbl::test::kitti_seq04();
   if (!seq) return;
   const auto kitti = rgbl::read_kitti_odometry_calibration(*seq / "calib.txt", 1226, 370);
-  rgbl::DepthSourceSettings s;
+  rgbl::DepthSourceContext s;
   s.calibration = kitti.camera(0);
   s.stereo_baseline = kitti.baseline(0, 1);
   const double fb = s.calibration.camera.fx * s.stereo_baseline;
-  const auto registry = rgbl::DepthSourceRegistry::with_builtins();
+  const auto registry = rgbl::builtin_depth_sources();
   auto stereo = registry.create("stereo_sparse", s);
   auto lidar = registry.create("lidar", s);
   const auto scan = rgbl::read_kitti_scan(*seq / "velodyne/000000.bin");
@@ -247,8 +252,9 @@ TEST_CASE("stereo_sparse on real KITTI frames: exact on a shifted real image, cl
   CHECK(plain[2] < 0.08);
 
   // the left-right check drops some of the disagreeing matches
-  s.stereo_sparse.left_right_check = true;
-  auto checked_source = registry.create("stereo_sparse", s);
+  rgbl::StereoSparseSourceOptions checked_options;
+  checked_options.left_right_check = true;
+  auto checked_source = rgbl::make_stereo_sparse_source(checked_options, s);
   checked_source->prepare(frame);
   const auto checked = compare(*checked_source);
   INFO("with the left-right check: " << checked[0] << " points, median " << checked[1] << ", p75 " << checked[2]);

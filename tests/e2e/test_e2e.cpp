@@ -5,7 +5,7 @@
 // Each sequence is rendered once per test binary (function-local statics) with only the parts the
 // tests use: grey images 0 and 1, the scan and cam0's exact depth.
 #include "rgbl/depth/evaluation.hpp"
-#include "rgbl/depth/registry.hpp"
+#include "rgbl/depth/sources.hpp"
 #include "rgbl/eval/trajectory_metrics.hpp"
 #include "rgbl/features/orb.hpp"
 #include "rgbl/geometry/projection.hpp"
@@ -69,12 +69,20 @@ const SimData& curve_street() {
   return data;
 }
 
-rgbl::DepthSourceSettings depth_settings(const SimData& data) {
-  rgbl::DepthSourceSettings s;
-  s.calibration = data.calibration.camera(0);
-  s.stereo_baseline = data.calibration.baseline(0, 1);
-  s.rgbd.max_depth = 80.0F;  // a street, not a room
-  return s;
+rgbl::DepthSourceContext depth_context(const SimData& data) {
+  rgbl::DepthSourceContext c;
+  c.calibration = data.calibration.camera(0);
+  c.stereo_baseline = data.calibration.baseline(0, 1);
+  return c;
+}
+
+// The built-ins, with rgbd's range for a street rather than a room.
+rgbl::DepthSourceRegistry street_sources() {
+  auto registry = rgbl::builtin_depth_sources();
+  rgbl::RgbdSourceOptions rgbd;
+  rgbd.max_depth = 80.0F;
+  registry.add("rgbd", rgbl::rgbd_depth_source(rgbd));
+  return registry;
 }
 
 struct RunResult {
@@ -85,10 +93,10 @@ struct RunResult {
 };
 
 // Tracks every frame with the named source. The exact depth goes in as the frame's float depth image
-// for rgbd; precomputed reads its PNGs from settings.precomputed.folder.
-RunResult track(const SimData& data, const std::string& source, const rgbl::DepthSourceSettings& settings) {
+// for rgbd; `source` is a --depth spec (precomputed:<folder> reads its PNGs there).
+RunResult track(const SimData& data, const std::string& source) {
   rgbl::OrbExtractor orb;
-  rgbl::System system({}, data.calibration.camera(0), rgbl::DepthSourceRegistry::with_builtins().create(source, settings),
+  rgbl::System system({}, data.calibration.camera(0), street_sources().create(source, depth_context(data)),
                       [&orb](const cv::Mat& grey, std::vector<rgbl::Keypoint>& keypoints,
                              std::vector<rgbl::Descriptor>& descriptors) { orb.extract(grey, keypoints, descriptors); });
   RunResult run;
@@ -133,22 +141,22 @@ TEST_CASE("every depth source tracks the synthetic street", "[e2e]") {
   };
   // bounds: the figures measured with seed 1 (docs/synthetic.md) with a margin
   const std::vector<Case> cases{
-      {"lidar (diamond5)", "lidar", 0.30, 1.5},     {"lidar:ipbasic", "lidar", 0.40, 2.0},
+      {"lidar (diamond5)", "lidar", 0.30, 1.5},     {"lidar:ipbasic", "lidar:ipbasic", 0.40, 2.0},
       {"stereo (SGBM)", "stereo", 0.65, 3.0},       {"rgbd (exact depth)", "rgbd", 0.20, 0.8},
       {"precomputed (exact)", "precomputed", 0.15, 0.6},
   };
   for (const auto& c : cases) {
     DYNAMIC_SECTION(c.label) {
-      auto settings = depth_settings(data);
-      if (c.label == "lidar:ipbasic") settings.lidar.completion = rgbl::CompletionMethod::ip_basic_fast;
+      std::string spec = c.source;
       if (c.source == "precomputed") {
-        settings.precomputed.folder = temp.path() / "depth";
-        std::filesystem::create_directories(settings.precomputed.folder);
+        const auto folder = temp.path() / "depth";
+        std::filesystem::create_directories(folder);
         for (std::size_t i = 0; i < n; ++i) {
-          rgbl::write_depth_png(settings.precomputed.folder / fmt::format("{:06d}.png", i), data.frames[i].depth);
+          rgbl::write_depth_png(folder / fmt::format("{:06d}.png", i), data.frames[i].depth);
         }
+        spec = "precomputed:" + folder.string();
       }
-      const RunResult run = track(data, c.source, settings);
+      const RunResult run = track(data, spec);
       report(c.label, run, n);
       REQUIRE(run.trajectory.size() == n);
       CHECK(run.results.front().state == rgbl::TrackState::Ok);  // depth from the first frame: initialised at once
@@ -162,12 +170,12 @@ TEST_CASE("every depth source tracks the synthetic street", "[e2e]") {
 TEST_CASE("the 5x5 diamond against the exact depth", "[e2e][depth]") {
   // only the scans and the exact depth of every 5th frame of the curve
   const rgbl::SyntheticGenerator generator(curve_options());
-  rgbl::DepthSourceSettings settings;
+  rgbl::DepthSourceContext settings;
   settings.calibration = generator.calibration().camera(0);
-  const auto diamond = rgbl::make_lidar_source(settings);
-  auto ip_settings = settings;
-  ip_settings.lidar.completion = rgbl::CompletionMethod::ip_basic_fast;
-  const auto ip_basic = rgbl::make_lidar_source(ip_settings);
+  const auto diamond = rgbl::make_lidar_source({}, settings);
+  rgbl::LidarSourceOptions ip_options;
+  ip_options.completion = rgbl::CompletionMethod::ip_basic_fast;
+  const auto ip_basic = rgbl::make_lidar_source(ip_options, settings);
   rgbl::DepthErrorAccumulator sparse_errors, diamond_errors, ip_basic_errors;
   for (int i = 0; i < generator.frame_count(); i += 5) {
     const std::vector<rgbl::LidarPoint> scan = generator.render_scan(i);
@@ -179,7 +187,7 @@ TEST_CASE("the 5x5 diamond against the exact depth", "[e2e][depth]") {
     ip_basic->prepare(frame);
     // the projected scan alone: what the completion starts from
     cv::Mat_<float> sparse(settings.calibration.camera.height, settings.calibration.camera.width, 0.0F);
-    rgbl::project_to_depth(scan, settings.calibration.P_img_lidar(), settings.lidar.projection, sparse);
+    rgbl::project_to_depth(scan, settings.calibration.P_img_lidar(), rgbl::ProjectionOptions{}, sparse);
     sparse_errors.add(sparse, exact);
     diamond_errors.add(diamond->dense_depth(), exact);
     ip_basic_errors.add(ip_basic->dense_depth(), exact);
@@ -254,7 +262,7 @@ TEST_CASE("an untextured stretch is survived", "[e2e]") {
     o.untextured = rgbl::FrameRange{15, 22};
     return render(o);
   }();
-  const RunResult run = track(data, "lidar", depth_settings(data));
+  const RunResult run = track(data, "lidar");
   report("untextured 15..22", run, data.frames.size());
   check_survived(data, run, 15, 22);
   // Plain surfaces still have corners (object outlines, shading of faces, markings' edges): ORB finds
@@ -283,7 +291,7 @@ TEST_CASE("a blank camera is survived: lost, then relocalised", "[e2e]") {
     data.frames[static_cast<std::size_t>(i)].left = cv::Mat(data.frames[0].left.size(), CV_8UC1, cv::Scalar(128));
     data.frames[static_cast<std::size_t>(i)].right = data.frames[static_cast<std::size_t>(i)].left;
   }
-  const RunResult run = track(data, "lidar", depth_settings(data));
+  const RunResult run = track(data, "lidar");
   report("blank camera 20..24", run, data.frames.size());
   check_survived(data, run, 20, 24);
   // nothing to see: lost, reported as such; relocalised on the map at the first image again
@@ -303,7 +311,7 @@ TEST_CASE("dropped scans are survived", "[e2e]") {
     o.dropped_scans = {15, 20, 21, 22};
     return render(o);
   }();
-  const RunResult run = track(data, "lidar", depth_settings(data));
+  const RunResult run = track(data, "lidar");
   report("dropped scans", run, data.frames.size());
   check_survived(data, run, 15, 22);
   // frames without depth are tracked on the map alone (measured: 40/40, ATE 0.06 m)

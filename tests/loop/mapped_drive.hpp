@@ -24,10 +24,10 @@ template <class Load>
 Mapped track_frames(const CameraCalibration& calibration, std::size_t count, Load load, const SystemOptions& options = {}) {
   Mapped m;
   m.calibration = calibration;
-  DepthSourceSettings depth;
+  DepthSourceContext depth;
   depth.calibration = m.calibration;
   auto orb = std::make_shared<OrbExtractor>();
-  m.system = std::make_unique<System>(options, m.calibration, make_lidar_source(depth),
+  m.system = std::make_unique<System>(options, m.calibration, make_lidar_source({}, depth),
                                       [orb](const cv::Mat& gray, std::vector<Keypoint>& kps, std::vector<Descriptor>& desc) {
                                         orb->extract(gray, kps, desc);
                                       });

@@ -38,12 +38,12 @@ inline Outcome run(const std::filesystem::path& sequence, const std::vector<Step
   const auto name = [](std::size_t i) { return fmt::format("{:06}", i); };
   const cv::Mat first = cv::imread((sequence / "image_0" / (name(0) + ".png")).string(), cv::IMREAD_GRAYSCALE);
   const auto kitti = rgbl::read_kitti_odometry_calibration(sequence / "calib.txt", first.cols, first.rows);
-  rgbl::DepthSourceSettings depth;
+  rgbl::DepthSourceContext depth;
   depth.calibration = kitti.camera(0);
   auto orb = std::make_shared<rgbl::OrbExtractor>();
   rgbl::SystemOptions options;
   options.threaded_mapping = threaded;
-  rgbl::System system(options, depth.calibration, rgbl::make_lidar_source(depth),
+  rgbl::System system(options, depth.calibration, rgbl::make_lidar_source({}, depth),
                       [orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
                         orb->extract(g, k, d);
                       });

@@ -26,10 +26,10 @@ inline SequenceRun run_sequence(const std::filesystem::path& dir, int camera, st
                                 const SystemOptions& options = {}) {
   const auto sequence = open_kitti_odometry(dir);
   const CameraCalibration calibration = sequence->calibration().camera(camera);
-  DepthSourceSettings depth;
+  DepthSourceContext depth;
   depth.calibration = calibration;
   auto orb = std::make_shared<OrbExtractor>();
-  System system(options, calibration, make_lidar_source(depth),
+  System system(options, calibration, make_lidar_source({}, depth),
                 [orb](const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors) {
                   orb->extract(gray, keypoints, descriptors);
                 });

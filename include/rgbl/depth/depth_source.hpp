@@ -1,7 +1,8 @@
 #pragma once
 // The interface between "where depth comes from" and the tracker. A DepthSource turns one frame's
 // sensor data (LiDAR scan, stereo pair, depth image, ...) into metric depth at keypoints, with what
-// the tracker needs to weight it. Strategies are created by name (see the registry in this module).
+// the tracker needs to weight it. Strategies are created by name (registry.hpp). This header and the
+// registry are the target rgbl::depth_api, which the tracker links; the built-in sources are rgbl::depth.
 
 #include "rgbl/geometry/calibration.hpp"
 #include "rgbl/geometry/point_cloud.hpp"
@@ -30,6 +31,22 @@ struct KeypointDepth {
   float z = 0.0F;                   // camera depth (along the optical axis), metres
   float sample_distance_px = 0.0F;  // pixel distance to the real measurement the value came from
   float spread = 0.0F;              // max - min of valid depths under the kernel, metres (depth edge)
+};
+
+// What a source reads from each frame besides the tracked image: a pipeline checks the dataset has
+// it before the first frame.
+struct DepthSourceNeeds {
+  bool scan = false;         // a LiDAR scan
+  bool right_image = false;  // the rectified right image of the tracked camera's stereo pair
+  bool depth_image = false;  // a depth camera's (or precomputed) image in SensorFrame::depth_image
+};
+
+// What a source is created with besides its own options: the tracked camera as the dataset gives it.
+struct DepthSourceContext {
+  CameraCalibration calibration{};  // tracked (rectified) camera, with T_cam_lidar
+  double stereo_baseline = 0.0;     // m, to the right camera of the pair; 0 without one
+
+  void validate() const;  // the camera's intrinsics; throws ConfigError
 };
 
 class DepthSource {

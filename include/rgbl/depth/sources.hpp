@@ -1,17 +1,19 @@
 #pragma once
 // The built-in depth sources and the settings they are created from. Each source turns one frame's
 // sensor data into depth at keypoints (with the distance to the real measurement and the local depth
-// spread) and into a dense map on demand. Create them by name through DepthSourceRegistry.
+// spread) and into a dense map on demand. Create them directly or by name through a DepthSourceRegistry.
 
 #include "rgbl/depth/completion.hpp"
 #include "rgbl/depth/depth_source.hpp"
 #include "rgbl/depth/ip_basic.hpp"
+#include "rgbl/depth/registry.hpp"
 #include "rgbl/geometry/calibration.hpp"
 #include "rgbl/geometry/projection.hpp"
 
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace rgbl {
 
@@ -97,24 +99,31 @@ struct RgbdSourceOptions {
   void validate() const;
 };
 
-// What every depth source may need. Only the chosen source's options are validated on creation.
-struct DepthSourceSettings {
-  CameraCalibration calibration{};   // the tracked (rectified) camera
-  double stereo_baseline = 0.0;      // m, from the calibration (KittiCalibration::baseline)
-  LidarSourceOptions lidar{};
-  PrecomputedSourceOptions precomputed{};
-  StereoSourceOptions stereo{};
-  StereoSparseSourceOptions stereo_sparse{};
-  RgbdSourceOptions rgbd{};
+// The built-ins, created directly (the options are validated, naming their key).
+std::unique_ptr<DepthSource> make_lidar_source(const LidarSourceOptions& options, const DepthSourceContext& context);
+std::unique_ptr<DepthSource> make_precomputed_source(const PrecomputedSourceOptions& options,
+                                                     const DepthSourceContext& context);
+std::unique_ptr<DepthSource> make_stereo_source(const StereoSourceOptions& options, const DepthSourceContext& context);
+std::unique_ptr<DepthSource> make_stereo_sparse_source(const StereoSparseSourceOptions& options,
+                                                       const DepthSourceContext& context);
+std::unique_ptr<DepthSource> make_rgbd_source(const RgbdSourceOptions& options, const DepthSourceContext& context);
 
-  void validate() const;  // the calibration only; each source validates its own options
-};
+// The `lidar` argument on top of `options`: empty or "dilation" (as is), "dilated" (the paper's keypoint
+// depth), "ipbasic", "ipbasic-multiscale", or <diamond|rectangle|cross><odd size 1..63>. Throws
+// ConfigError("--depth").
+void apply_lidar_argument(std::string_view argument, LidarSourceOptions& options);
 
-std::unique_ptr<DepthSource> make_lidar_source(const DepthSourceSettings& settings);
-std::unique_ptr<DepthSource> make_precomputed_source(const DepthSourceSettings& settings);
-std::unique_ptr<DepthSource> make_stereo_source(const DepthSourceSettings& settings);
-std::unique_ptr<DepthSource> make_stereo_sparse_source(const DepthSourceSettings& settings);
-std::unique_ptr<DepthSource> make_rgbd_source(const DepthSourceSettings& settings);
+// Registry entries of the built-ins, each starting from the given options (e.g. a settings file's):
+// lidar[:argument] (needs scans), precomputed:<folder> (reads PNGs itself), stereo and stereo_sparse
+// (need the right image), rgbd (needs depth images).
+DepthSourceEntry lidar_depth_source(LidarSourceOptions options = {});
+DepthSourceEntry precomputed_depth_source(PrecomputedSourceOptions options = {});
+DepthSourceEntry stereo_depth_source(StereoSourceOptions options = {});
+DepthSourceEntry stereo_sparse_depth_source(StereoSparseSourceOptions options = {});
+DepthSourceEntry rgbd_depth_source(RgbdSourceOptions options = {});
+
+// lidar, precomputed, stereo, stereo_sparse and rgbd with default options.
+DepthSourceRegistry builtin_depth_sources();
 
 // Reads a depth PNG (uint16, depth x 256) into metres. Throws ParseError naming the file.
 cv::Mat_<float> read_depth_png(const std::filesystem::path& file);

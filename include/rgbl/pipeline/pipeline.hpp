@@ -8,7 +8,7 @@
 //   const rgbl::RunResult result = pipeline.run();
 //   rgbl::write_run_outputs(result, "out");  // trajectory_kitti.txt, summary.json, ...
 
-#include "rgbl/depth/registry.hpp"
+#include "rgbl/depth/sources.hpp"
 #include "rgbl/eval/trajectory_metrics.hpp"
 #include "rgbl/features/orb.hpp"
 #include "rgbl/io/sequence.hpp"
@@ -103,16 +103,17 @@ struct RunResult {
 // option, file or key that is wrong, before any frame is tracked.
 class Pipeline {
  public:
-  // Throws rgbl::Error (ConfigError, ParseError). `registry` resolves options.depth.
-  explicit Pipeline(const PipelineOptions& options,
-                    const DepthSourceRegistry& registry = DepthSourceRegistry::with_builtins());
+  // Throws rgbl::Error (ConfigError, ParseError). `registry` resolves options.depth; a settings file
+  // replaces its lidar and rgbd entries with built-ins starting from the file's options.
+  explicit Pipeline(const PipelineOptions& options, const DepthSourceRegistry& registry = builtin_depth_sources());
 
   const PipelineOptions& options() const { return options_; }
   const Sequence& sequence() const { return *sequence_; }
   int camera() const { return camera_; }
-  const CameraCalibration& calibration() const { return calibration_; }
-  const std::string& depth_name() const { return depth_name_; }
-  const DepthSourceSettings& depth_settings() const { return depth_settings_; }
+  const CameraCalibration& calibration() const { return context_.calibration; }
+  const DepthSourceContext& depth_context() const { return context_; }
+  const std::string& depth_name() const { return depth_name_; }  // the registry name of options().depth
+  const LidarSourceOptions& lidar_options() const { return lidar_; }  // the settings file's (defaults without one)
   const SystemOptions& system_options() const { return system_; }
   const OrbOptions& orb_options() const { return orb_; }
   std::size_t first() const { return first_; }
@@ -138,9 +139,9 @@ class Pipeline {
   std::unique_ptr<Sequence> sequence_;
   DepthSourceRegistry registry_;
   int camera_ = 0;
-  CameraCalibration calibration_;
+  DepthSourceContext context_;
   std::string depth_name_;
-  DepthSourceSettings depth_settings_;
+  LidarSourceOptions lidar_;
   SystemOptions system_;
   OrbOptions orb_;
   std::size_t first_ = 0, count_ = 0, step_ = 1;
