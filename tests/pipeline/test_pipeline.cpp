@@ -1,0 +1,157 @@
+#include "rgbl/core/error.hpp"
+#include "rgbl/pipeline/pipeline.hpp"
+#include "rgbl/sim/synthetic.hpp"
+#include "support/temp_dir.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <sstream>
+
+using Catch::Matchers::Contains;
+
+namespace {
+
+// 40 frames of a curve with exact ground truth, camera 0 and the LiDAR only, written once.
+const rgbl::KittiLayout& curve() {
+  static const rgbl::test::TempDir dir;
+  static const rgbl::KittiLayout layout = [] {
+    rgbl::SyntheticOptions o;
+    o.frames = 40;
+    o.path.kind = rgbl::PathKind::curve;
+    o.cameras = {true, false, false, false};
+    o.render_depth = false;
+    return rgbl::write_kitti(rgbl::SyntheticGenerator(o), dir.path(), 0);
+  }();
+  return layout;
+}
+
+rgbl::PipelineOptions options() {
+  rgbl::PipelineOptions o;
+  o.dataset = curve().sequence_dir;
+  return o;
+}
+
+std::string read(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+TEST_CASE("a pipeline tracks a sequence, re-expresses it in the ground truth's world and evaluates it") {
+  auto o = options();
+  o.first = 4;
+  o.step = 2;
+  const rgbl::Pipeline pipeline(o);
+  REQUIRE(pipeline.frame_count() == 18);  // frames 4, 6, ..., 38
+  CHECK(pipeline.depth_name() == "lidar");
+  CHECK(pipeline.camera() == 0);
+  std::vector<std::size_t> progress;
+  const rgbl::RunResult run = pipeline.run([&](const rgbl::FrameRecord& r, std::size_t done, std::size_t total) {
+    CHECK(total == 18);
+    CHECK(r.result.frame_index == 4 + 2 * (done - 1));
+    progress.push_back(done);
+  });
+  CHECK(progress.size() == 18);
+  REQUIRE(run.frames.size() == 18);
+  CHECK(run.frames.back().result.frame_index == 38);
+  CHECK(run.count(rgbl::TrackState::Ok) == 18);
+  REQUIRE(run.trajectory.poses.size() == 18);
+  REQUIRE(run.ground_truth.size() == 18);
+  // the first pose is the ground truth's at frame 4 exactly: the world is the ground truth's
+  CHECK((run.trajectory.poses[0].matrix() - run.ground_truth[0].matrix()).norm() < 1e-9);
+  REQUIRE(run.metrics.has_value());
+  CHECK(run.metrics->frames_with_ground_truth == 18);
+  CHECK(run.metrics->evaluation.ate.translation.rmse < 0.15);
+  CHECK(run.metrics->kitti_lengths == rgbl::describe_lengths(run.metrics->evaluation.kitti_options));
+  CHECK(run.keyframe_count() >= 2);
+  CHECK(run.landmarks.size() > 100);
+  CHECK(run.keyframes.size() == run.keyframe_count());
+  REQUIRE(run.min_inliers_ok().has_value());
+  CHECK(*run.min_inliers_ok() >= 30);
+  CHECK(run.timings().total.median > 0.0);
+
+  // inline runs are reproducible to the bit
+  const rgbl::RunResult again = pipeline.run();
+  for (std::size_t i = 0; i < run.trajectory.poses.size(); ++i) {
+    CHECK(run.trajectory.poses[i].matrix() == again.trajectory.poses[i].matrix());
+  }
+
+  rgbl::test::TempDir out;
+  rgbl::write_run_outputs(run, out.path() / "run");
+  for (const auto& name : rgbl::run_output_files()) CHECK(std::filesystem::exists(out.path() / "run" / name));
+  const auto summary = nlohmann::json::parse(read(out.path() / "run" / "summary.json"));
+  CHECK(summary["frames"] == 18);
+  CHECK(summary["first_frame"] == 4);
+  CHECK(summary["step"] == 2);
+  CHECK(summary["depth"] == "lidar");
+  CHECK(summary["metrics"]["ate_rmse_m"].get<double>() == Approx(run.metrics->evaluation.ate.translation.rmse));
+  CHECK(summary["stage_ms"]["total"]["median"].get<double>() > 0.0);
+  CHECK(summary["loop_closures"].is_array());
+  CHECK(summary["min_inliers_ok"] == *run.min_inliers_ok());
+  // 18 rows, each a 3x4 pose; row 0 is the ground truth's frame 4
+  CHECK(std::count(std::istreambuf_iterator<char>(std::ifstream(out.path() / "run" / "trajectory_kitti.txt").rdbuf()),
+                   {}, '\n') == 18);
+  rgbl::remove_run_outputs(out.path() / "run");
+  for (const auto& name : rgbl::run_output_files()) CHECK_FALSE(std::filesystem::exists(out.path() / "run" / name));
+}
+
+TEST_CASE("a pipeline refuses bad options and data it cannot use before the first frame, naming them") {
+  auto o = options();
+  o.camera = 1;
+  CHECK_THROWS_WITH(rgbl::Pipeline(o), Contains("camera"));
+  o = options();
+  o.camera = 2;
+  CHECK_THROWS_WITH(rgbl::Pipeline(o), Contains("has no camera 2"));
+  o = options();
+  o.step = 0;
+  CHECK_THROWS_WITH(rgbl::Pipeline(o), Contains("step"));
+  o = options();
+  o.first = 40;
+  CHECK_THROWS_WITH(rgbl::Pipeline(o), Contains("--first") && Contains("below 40"));
+  o = options();
+  o.dataset = curve().root / "nothing_here";
+  CHECK_THROWS_WITH(rgbl::Pipeline(o), Contains("nothing_here"));
+  o = options();
+  o.depth = "neural";
+  CHECK_THROWS_WITH(rgbl::Pipeline(o), Contains("'neural'") && Contains("lidar[:") && Contains("rgbd"));
+  o.depth = "stereo";  // no image_1 was written
+  CHECK_THROWS_WITH(rgbl::Pipeline(o), Contains("stereo needs camera 1"));
+  o.depth = "rgbd";
+  CHECK_THROWS_WITH(rgbl::Pipeline(o), Contains("rgbd needs depth images") && Contains("sequences/00"));
+  o.depth = "lidar:hexagon3";
+  CHECK_THROWS_WITH(rgbl::Pipeline(o), Contains("lidar:hexagon3"));
+  o.depth = "precomputed:" + (curve().root / "no_depth").string();  // the folder is read per frame
+  const rgbl::Pipeline lazy(o);
+  CHECK_THROWS_WITH(lazy.run(), Contains("no_depth") && Contains("000000.png"));
+}
+
+TEST_CASE("a pipeline creates a user's depth source by name and checks what it needs") {
+  auto sources = rgbl::builtin_depth_sources();
+  int created = 0;
+  sources.add("far_lidar", {{.scan = true}, "far_lidar:<metres>", [&created](std::string_view arg, const auto& context) {
+                              ++created;
+                              rgbl::LidarSourceOptions lidar;
+                              lidar.projection.max_depth = lidar.dilation.max_depth = std::stof(std::string(arg));
+                              return rgbl::make_lidar_source(lidar, context);
+                            }});
+  auto o = options();
+  o.frames = 10;
+  o.depth = "far_lidar:50";
+  const rgbl::Pipeline pipeline(o, sources);
+  CHECK(created == 1);  // once at construction: its options are checked before any frame
+  const rgbl::RunResult run = pipeline.run();
+  CHECK(created == 2);
+  CHECK(run.depth == "far_lidar");
+  CHECK(run.count(rgbl::TrackState::Ok) == 10);
+
+  sources.add("depth_camera", {{.depth_image = true}, "depth_camera", [](std::string_view, const auto& context) {
+                                 return rgbl::make_rgbd_source({}, context);
+                               }});
+  o.depth = "depth_camera";
+  CHECK_THROWS_WITH(rgbl::Pipeline(o, sources), Contains("depth_camera needs depth images"));
+}
