@@ -8,6 +8,7 @@
 #include "input_options.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 #include "rgbl/core/timer.hpp"
 #include "rgbl/sim/scenarios.hpp"
 #include "rgbl/sim/synthetic.hpp"
@@ -46,28 +47,6 @@ struct DemoArgs {
   bool no_loop_closing = false;
 };
 
-// A fresh folder under the system's temp directory, removed (with everything in it) on destruction.
-class TempFolder {
- public:
-  TempFolder() {
-    std::string pattern = (fs::temp_directory_path() / "rgbl_demo_XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr) {
-      throw Error(fmt::format("{}: cannot create a temporary folder", pattern));
-    }
-    path_ = pattern;
-  }
-  ~TempFolder() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempFolder(const TempFolder&) = delete;
-  TempFolder& operator=(const TempFolder&) = delete;
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
 void print_scenarios() {
   for (const ScenarioInfo& s : scenarios()) {
     fmt::print("{:<14} {} (default {} frames)\n", s.name, s.description, s.default_frames);
@@ -91,20 +70,7 @@ int run_demo(const DemoArgs& args, bool quiet) {
   if (args.laps != 1 && sim.path.kind != PathKind::loop) {
     throw ConfigError("--laps", "--path loop (the other paths and the scenarios do not come back)");
   }
-  if (sim.path.kind == PathKind::loop) {
-    // the loop's perimeter is the distance driven over the laps: shrink the corners (down to the
-    // generator's 12 m) so that a shorter demo still closes its loop
-    sim.path.loop_laps = args.laps;
-    const double perimeter = (sim.frames - 1) * sim.step() / args.laps;
-    const double radius = std::max(12.0, std::min(sim.path.loop_corner_radius, perimeter / (2.0 * std::numbers::pi)));
-    sim.path.loop_corner_radius = radius;
-    if (perimeter < 2.0 * std::numbers::pi * radius) {
-      throw ConfigError("--frames", fmt::format("at least {} frames for {} lap(s) of a loop (corners of {:g} m radius)",
-                                                static_cast<int>(std::ceil(args.laps * 2.0 * std::numbers::pi * radius /
-                                                                           sim.step())) + 1,
-                                                args.laps, radius));
-    }
-  }
+  if (sim.path.kind == PathKind::loop) fit_loop(sim, args.laps);
 
   // refuse what cannot work before spending the generation time on it (the layout has no depth camera)
   const std::string spec = args.depth == "precomputed" ? "precomputed:exact" : args.depth;
@@ -121,10 +87,10 @@ int run_demo(const DemoArgs& args, bool quiet) {
   sim.render_depth = args.depth == "precomputed";
   sim.validate();
 
-  std::optional<TempFolder> temp;
+  std::optional<TemporaryFolder> temp;
   fs::path root;
   if (args.keep.empty()) {
-    temp.emplace();
+    temp.emplace("rgbl_demo");
     root = temp->path();
   } else {
     root = args.keep;

@@ -3,6 +3,7 @@
 #include "rgbl/core/error.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <system_error>
 
@@ -29,6 +30,17 @@ void write_atomically(const std::filesystem::path& file, const std::function<voi
     std::filesystem::remove(tmp, ec);
     throw Error(fmt::format("{}: cannot move the finished file into place", file.string()));
   }
+}
+
+TemporaryFolder::TemporaryFolder(const std::string& prefix) {
+  std::string pattern = (std::filesystem::temp_directory_path() / (prefix + "_XXXXXX")).string();
+  if (::mkdtemp(pattern.data()) == nullptr) throw Error(fmt::format("{}: cannot create a temporary folder", pattern));
+  path_ = pattern;
+}
+
+TemporaryFolder::~TemporaryFolder() {
+  std::error_code ec;
+  std::filesystem::remove_all(path_, ec);
 }
 
 }  // namespace rgbl

@@ -4,6 +4,7 @@
 #include "rgbl/core/error.hpp"
 #include "texture.hpp"
 
+#include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -660,6 +661,21 @@ SyntheticSequence generate_sequence(const SyntheticOptions& options) {
   seq.frames.reserve(static_cast<std::size_t>(generator.frame_count()));
   for (int i = 0; i < generator.frame_count(); ++i) seq.frames.push_back(generator.render(i));
   return seq;
+}
+
+void fit_loop(SyntheticOptions& options, int laps) {
+  require(laps >= 1, "--laps", "at least 1 lap");
+  options.path.kind = PathKind::loop;
+  options.path.loop_laps = laps;
+  const double perimeter = (options.frames - 1) * options.step() / laps;
+  const double radius = std::max(12.0, std::min(options.path.loop_corner_radius, perimeter / (2.0 * std::numbers::pi)));
+  options.path.loop_corner_radius = radius;
+  if (perimeter < 2.0 * std::numbers::pi * radius) {
+    throw ConfigError("--frames", fmt::format("at least {} frames for {} lap(s) of a loop (corners of {:g} m radius)",
+                                              static_cast<int>(std::ceil(laps * 2.0 * std::numbers::pi * radius /
+                                                                         options.step())) + 1,
+                                              laps, radius));
+  }
 }
 
 }  // namespace rgbl

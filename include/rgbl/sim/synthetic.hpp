@@ -185,6 +185,11 @@ class SyntheticGenerator {
   std::unique_ptr<StreetScene> scene_;
 };
 
+// Makes options.path a `laps`-lap loop whose perimeter is the distance driven over options.frames:
+// the corners shrink (down to the generator's 12 m) so that a short run still closes its loop.
+// Throws ConfigError("--frames") naming the frames needed when they cannot close the laps.
+void fit_loop(SyntheticOptions& options, int laps);
+
 // All frames in memory (for tests: keep them few and small).
 SyntheticSequence generate_sequence(const SyntheticOptions& options);
 

@@ -1,0 +1,142 @@
+#include "rgbl/pipeline/compare.hpp"
+
+#include "rgbl/core/error.hpp"
+#include "rgbl/io/trajectory_io.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+
+namespace rgbl {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+Json number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+Json stats_json(const ErrorStats& s) {
+  return {{"rmse", number(s.rmse)}, {"mean", number(s.mean)}, {"median", number(s.median)}, {"max", number(s.max)}};
+}
+
+}  // namespace
+
+void CompareOptions::validate() const {
+  require(format == "auto" || format == "kitti" || format == "tum", "--format", "auto, kitti or tum");
+  for (const double l : lengths) require(l > 0.0 && std::isfinite(l), "--lengths", "lengths > 0 m");
+  require(step >= 1, "--step", "at least 1 frame between segment starts");
+  require(max_time_difference >= 0.0, "--max-dt", "a time difference >= 0 s");
+}
+
+// "kitti" (12 numbers per row) or "tum" (8), from the first data row.
+std::string detect_trajectory_format(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw ParseError(file, 0, "cannot open the file (expected a KITTI or TUM trajectory)");
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto start = line.find_first_not_of(" \t\r");
+    if (start == std::string::npos || line[start] == '#') continue;
+    std::size_t fields = 0;
+    for (std::size_t pos = start; pos < line.size();) {
+      const auto b = line.find_first_not_of(" \t\r,", pos);
+      if (b == std::string::npos) break;
+      ++fields;
+      pos = line.find_first_of(" \t\r,", b);
+      if (pos == std::string::npos) break;
+    }
+    if (fields == 12) return "kitti";
+    if (fields == 8) return "tum";
+    throw ParseError(
+        file, line_no,
+        fmt::format("found {} fields: expected 12 (KITTI: row-major 3x4) or 8 (TUM: t tx ty tz qx qy qz qw)", fields));
+  }
+  throw ParseError(file, 0, "no poses in the file");
+}
+
+TrajectoryComparison compare_trajectory_files(const std::filesystem::path& estimate,
+                                              const std::filesystem::path& ground_truth,
+                                              const CompareOptions& options) {
+  options.validate();
+  TrajectoryComparison c;
+  c.estimate = estimate;
+  c.ground_truth = ground_truth;
+  const std::string est_format = options.format == "auto" ? detect_trajectory_format(estimate) : options.format;
+  const std::string gt_format = options.format == "auto" ? detect_trajectory_format(ground_truth) : options.format;
+  if (est_format != gt_format) {
+    throw Error(fmt::format("{} is a {} trajectory but {} is a {} one: convert one of them (or pass --format)",
+                            estimate.string(), est_format, ground_truth.string(), gt_format));
+  }
+  c.format = est_format;
+  std::vector<Eigen::Isometry3d> est, gt;
+  if (est_format == "kitti") {
+    est = read_kitti_trajectory(estimate);
+    gt = read_kitti_trajectory(ground_truth);
+    c.estimated_poses = est.size();
+    if (gt.size() < est.size()) {
+      throw ParseError(ground_truth, 0,
+                       fmt::format("has {} poses, fewer than the {} of {}", gt.size(), est.size(), estimate.string()));
+    }
+    if (gt.size() > est.size()) {
+      c.notes.push_back(fmt::format("using the first {} of the {} ground-truth poses (KITTI files pair by row)",
+                                    est.size(), gt.size()));
+      gt.resize(est.size());
+    }
+  } else {
+    const Trajectory e = read_tum_trajectory(estimate);
+    const Trajectory g = read_tum_trajectory(ground_truth);
+    c.estimated_poses = e.size();
+    const auto pairs = associate_timestamps(e.timestamps, g.timestamps, options.max_time_difference);
+    for (const auto& [i, j] : pairs) {
+      est.push_back(e.poses[i]);
+      gt.push_back(g.poses[j]);
+    }
+    c.notes.push_back(fmt::format("associated {} of {} estimated poses with ground truth within {} s", pairs.size(),
+                                  e.size(), options.max_time_difference));
+  }
+  if (est.size() < 2) {
+    throw Error(fmt::format("{} and {}: fewer than 2 poses to compare", estimate.string(), ground_truth.string()));
+  }
+  KittiMetricOptions kitti = kitti_options_for_path(trajectory_distances(gt).back());
+  if (!options.lengths.empty()) kitti.lengths = options.lengths;
+  kitti.step_size = options.step;
+  c.evaluation = evaluate_trajectory(est, gt, kitti);
+  if (options.lengths.empty() && kitti.lengths != KittiMetricOptions{}.lengths) {
+    c.notes.push_back(fmt::format("the ground-truth path is {:.1f} m, too short for KITTI's 100..800 m segments: "
+                                  "using {} (not comparable with published KITTI figures)",
+                                  c.evaluation.path_length, describe_lengths(kitti)));
+  }
+  return c;
+}
+
+std::string comparison_json(const TrajectoryComparison& c) {
+  const TrajectoryEvaluation& e = c.evaluation;
+  Json per_length = Json::array();
+  for (const auto& l : e.kitti.per_length) {
+    per_length.push_back({{"length", l.length},
+                          {"segments", l.segments},
+                          {"t_err_percent", number(l.t_err_percent)},
+                          {"r_err_deg_per_100m", number(l.r_err_deg_per_100m)}});
+  }
+  const Json json = {{"estimate", c.estimate.generic_string()},
+                     {"ground_truth", c.ground_truth.generic_string()},
+                     {"format", c.format},
+                     {"poses", e.poses},
+                     {"path_length_m", number(e.path_length)},
+                     {"kitti",
+                      {{"lengths_m", e.kitti_options.lengths},
+                       {"step_frames", e.kitti_options.step_size},
+                       {"segments", e.kitti.segments},
+                       {"t_err_percent", number(e.kitti.t_err_percent)},
+                       {"r_err_deg_per_100m", number(e.kitti.r_err_deg_per_100m)},
+                       {"per_length", per_length}}},
+                     {"ate_m", stats_json(e.ate.translation)},
+                     {"rpe_translation_m", stats_json(e.rpe.translation)},
+                     {"rpe_rotation_deg", stats_json(e.rpe.rotation_deg)},
+                     {"drift", {{"end_error_m", number(e.drift.end_error)}, {"percent", number(e.drift.percent)}}}};
+  return json.dump(2) + "\n";
+}
+
+}  // namespace rgbl
