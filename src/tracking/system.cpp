@@ -168,26 +168,23 @@ struct System::Impl {
   }
 
   bool mapping_idle() const { return !options.threaded_mapping || mapping_queue.idle(); }
-};
 
-namespace {
-
-void compensate_lidar_motion(System::Impl& s, Frame& frame) {
-  const Vector6d xi = se3_log(*s.tracker.velocity());  // per frame period
-  const Eigen::Isometry3d T_lidar_cam = s.calibration.T_cam_lidar.inverse();
-  const double per_radian = s.options.lidar_spin * s.options.lidar_scan_period / (2.0 * M_PI) / s.options.frame_period;
-  for (std::size_t i = 0; i < frame.size(); ++i) {
-    if (frame.depth[i] <= 0.0F) continue;
-    const Eigen::Vector3d p = s.calibration.camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y),
+  // Each keypoint's depth moved to the frame's trigger time: the scan sweeps while the car moves.
+  void compensate_lidar_motion(Frame& frame) const {
+    const Vector6d xi = se3_log(*tracker.velocity());  // per frame period
+    const Eigen::Isometry3d T_lidar_cam = calibration.T_cam_lidar.inverse();
+    const double per_radian = options.lidar_spin * options.lidar_scan_period / (2.0 * M_PI) / options.frame_period;
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      if (frame.depth[i] <= 0.0F) continue;
+      const Eigen::Vector3d p = calibration.camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y),
                                                              frame.depth[i]);
-    const Eigen::Vector3d p_lidar = T_lidar_cam * p;
-    const double fraction = per_radian * std::atan2(p_lidar.y(), p_lidar.x());  // frames before the trigger
-    const Eigen::Vector3d corrected = se3_exp(fraction * xi) * p;
-    frame.depth[i] = static_cast<float>(corrected.z());
+      const Eigen::Vector3d p_lidar = T_lidar_cam * p;
+      const double fraction = per_radian * std::atan2(p_lidar.y(), p_lidar.x());  // frames before the trigger
+      const Eigen::Vector3d corrected = se3_exp(fraction * xi) * p;
+      frame.depth[i] = static_cast<float>(corrected.z());
+    }
   }
-}
-
-}  // namespace
+};
 
 System::System(SystemOptions options, CameraCalibration calibration, std::unique_ptr<DepthSource> depth,
                FeatureExtractor extractor) {
@@ -253,7 +250,7 @@ TrackResult System::track(const SensorFrame& sensor) {
     with_depth += sigma > 0.0 ? 1 : 0;
   }
   if (s.options.lidar_scan_period > 0.0 && has_pose(s.tracker.state()) && s.tracker.velocity()) {
-    compensate_lidar_motion(s, frame);
+    s.compensate_lidar_motion(frame);
   }
   frame.build_grid(s.calibration.camera.width, s.calibration.camera.height);
   result.timing.depth_ms += stage.lap_ms();

@@ -109,9 +109,8 @@ class System {
   // TrackResult of the first frame tracked after it; after finish() this holds them all.
   std::vector<LoopClosure> loop_closures() const;
 
- struct Impl;  // public name only so that helpers in the .cpp can take it
-
  private:
+  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
