@@ -14,7 +14,7 @@ namespace {
 // Pose block: [angle-axis of R_cam_world (3), t_cam_world (3)]; point block: world position.
 template <int kDim>
 struct ReprojectionDepthCost {
-  double fx, fy, cx, cy;
+  PinholeCamera camera;
   double u, v, inv_sigma_px;
   double z, inv_sigma_z;
 
@@ -25,9 +25,9 @@ struct ReprojectionDepthCost {
     p[0] += pose[3];
     p[1] += pose[4];
     p[2] += pose[5];
-    const T iz = T(1.0) / p[2];
-    residual[0] = (T(fx) * p[0] * iz + T(cx) - T(u)) * T(inv_sigma_px);
-    residual[1] = (T(fy) * p[1] * iz + T(cy) - T(v)) * T(inv_sigma_px);
+    const Eigen::Matrix<T, 2, 1> px = project_point(camera, p[0], p[1], p[2]);
+    residual[0] = (px.x() - u) * inv_sigma_px;
+    residual[1] = (px.y() - v) * inv_sigma_px;
     if constexpr (kDim == 3) residual[2] = (p[2] - T(z)) * T(inv_sigma_z);
     return true;
   }
@@ -38,11 +38,11 @@ bool has_depth(const BundleObservation& o) { return o.depth > 0.0 && o.depth_sig
 ceres::CostFunction* make_cost(const PinholeCamera& camera, const BundleObservation& o) {
   if (has_depth(o)) {
     return new ceres::AutoDiffCostFunction<ReprojectionDepthCost<3>, 3, 6, 3>(new ReprojectionDepthCost<3>{
-        camera.fx, camera.fy, camera.cx, camera.cy, o.pixel.x(), o.pixel.y(), 1.0 / o.sigma_px, o.depth,
+        camera, o.pixel.x(), o.pixel.y(), 1.0 / o.sigma_px, o.depth,
         1.0 / o.depth_sigma});
   }
   return new ceres::AutoDiffCostFunction<ReprojectionDepthCost<2>, 2, 6, 3>(new ReprojectionDepthCost<2>{
-      camera.fx, camera.fy, camera.cx, camera.cy, o.pixel.x(), o.pixel.y(), 1.0 / o.sigma_px, 0.0, 0.0});
+      camera, o.pixel.x(), o.pixel.y(), 1.0 / o.sigma_px, 0.0, 0.0});
 }
 
 class AbortCallback : public ceres::IterationCallback {
@@ -157,7 +157,7 @@ BundleAdjustmentResult bundle_adjust(const PinholeCamera& camera, BundleProblem&
       result.outlier[i] = true;
       continue;
     }
-    const Eigen::Vector2d px(camera.fx * p.x() / p.z() + camera.cx, camera.fy * p.y() / p.z() + camera.cy);
+    const Eigen::Vector2d px = camera.project_unchecked(p);
     double chi2 = (px - o.pixel).squaredNorm() / (o.sigma_px * o.sigma_px);
     if (has_depth(o)) {
       const double dz = (p.z() - o.depth) / o.depth_sigma;

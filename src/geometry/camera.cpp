@@ -18,9 +18,7 @@ Eigen::Matrix3d PinholeCamera::K() const {
 }
 
 Eigen::Vector2d PinholeCamera::project_unchecked(const Eigen::Vector3d& p_cam) const {
-  Eigen::Vector2d xn(p_cam.x() / p_cam.z(), p_cam.y() / p_cam.z());
-  if (!distortion.is_zero()) xn = distort(xn);
-  return {fx * xn.x() + cx, fy * xn.y() + cy};
+  return project_point(*this, p_cam.x(), p_cam.y(), p_cam.z());
 }
 
 std::optional<Eigen::Vector2d> PinholeCamera::project(const Eigen::Vector3d& p_cam) const {
@@ -37,12 +35,21 @@ Eigen::Vector3d PinholeCamera::unproject(const Eigen::Vector2d& px, double z) co
 }
 
 Eigen::Vector2d PinholeCamera::distort(const Eigen::Vector2d& xn) const {
-  const auto& d = distortion;
-  const double x = xn.x(), y = xn.y();
-  const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
-  return {x * radial + 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x),
-          y * radial + d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y};
+  double x = xn.x(), y = xn.y();
+  distortion.apply(x, y);
+  return {x, y};
+}
+
+Eigen::Matrix2d Distortion::jacobian(double u, double v) const {
+  const double r2 = u * u + v * v;
+  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double dradial_dr2 = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);
+  Eigen::Matrix2d J;
+  J(0, 0) = radial + 2.0 * u * u * dradial_dr2 + 2.0 * p1 * v + 6.0 * p2 * u;
+  J(0, 1) = 2.0 * u * v * dradial_dr2 + 2.0 * p1 * u + 2.0 * p2 * v;
+  J(1, 0) = J(0, 1);
+  J(1, 1) = radial + 2.0 * v * v * dradial_dr2 + 6.0 * p1 * v + 2.0 * p2 * u;
+  return J;
 }
 
 Eigen::Vector2d PinholeCamera::undistort(const Eigen::Vector2d& xd) const {
@@ -51,16 +58,7 @@ Eigen::Vector2d PinholeCamera::undistort(const Eigen::Vector2d& xd) const {
   for (int iteration = 0; iteration < 20; ++iteration) {
     const Eigen::Vector2d residual = distort(x) - xd;
     if (residual.squaredNorm() < 1e-26) break;
-    const double u = x.x(), v = x.y();
-    const double r2 = u * u + v * v;
-    const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
-    const double dradial_dr2 = d.k1 + r2 * (2.0 * d.k2 + 3.0 * r2 * d.k3);
-    Eigen::Matrix2d J;
-    J(0, 0) = radial + 2.0 * u * u * dradial_dr2 + 2.0 * d.p1 * v + 6.0 * d.p2 * u;
-    J(0, 1) = 2.0 * u * v * dradial_dr2 + 2.0 * d.p1 * u + 2.0 * d.p2 * v;
-    J(1, 0) = 2.0 * u * v * dradial_dr2 + 2.0 * d.p1 * u + 2.0 * d.p2 * v;
-    J(1, 1) = radial + 2.0 * v * v * dradial_dr2 + 6.0 * d.p1 * v + 2.0 * d.p2 * u;
-    x -= J.inverse() * residual;
+    x -= d.jacobian(x.x(), x.y()).inverse() * residual;
   }
   return x;
 }

@@ -29,8 +29,15 @@ Eigen::Isometry3d test_pose() {
 
 }  // namespace
 
+// KITTI's camera with a wide-angle lens' distortion: the backend must project as the camera does.
+rgbl::PinholeCamera distorted_camera() {
+  auto cam = rgbl::test::kitti_camera();
+  cam.distortion = {-0.28, 0.07, 0.0006, -0.0004, 0.0};
+  return cam;
+}
+
 TEST_CASE("pose residual Jacobian matches numeric differentiation") {
-  const auto cam = rgbl::test::kitti_camera();
+ for (const auto& cam : {rgbl::test::kitti_camera(), distorted_camera()}) {
   const Eigen::Isometry3d T = test_pose();
   std::mt19937 rng(1);
   const auto points = scene(rng, T, 20);
@@ -62,6 +69,36 @@ TEST_CASE("pose residual Jacobian matches numeric differentiation") {
       CHECK((numeric - J).norm() < 1e-4 * (1.0 + J.norm()));
     }
   }
+ }
+}
+
+TEST_CASE("pose optimisation and bundle adjustment project through the lens distortion") {
+  const auto cam = distorted_camera();
+  const Eigen::Isometry3d T = test_pose();
+  std::mt19937 rng(5);
+  const auto points = scene(rng, T, 60);
+  std::vector<rgbl::PoseObservation> obs;
+  rgbl::BundleProblem problem;
+  problem.poses.push_back({T, true});
+  rgbl::Vector6d offset;
+  offset << 0.05, -0.03, 0.2, 0.004, -0.003, 0.002;
+  problem.poses.push_back({rgbl::se3_exp(offset) * T, false});
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    rgbl::PoseObservation o;
+    o.p_world = points[i];
+    o.pixel = cam.project_unchecked(T * points[i]);  // exact, through the distortion
+    obs.push_back(o);
+    problem.points.push_back(points[i]);
+    const double z = (T * points[i]).z();
+    for (int k = 0; k < 2; ++k) problem.observations.push_back({k, static_cast<int>(i), o.pixel, 1.0, z, 0.05});
+  }
+  const auto result = rgbl::optimize_pose(cam, rgbl::se3_exp(offset) * T, obs);
+  CHECK(result.inliers == 60);
+  CHECK((result.T_cam_world.matrix() - T.matrix()).norm() < 1e-6);
+  rgbl::BundleAdjustmentOptions options;
+  options.iterations = 30;
+  (void)rgbl::bundle_adjust(cam, problem, options);
+  CHECK((problem.poses[1].T_cam_world.matrix() - T.matrix()).norm() < 1e-5);
 }
 
 TEST_CASE("pose optimisation recovers a known pose with noise and flags the outliers") {

@@ -12,6 +12,20 @@ struct Distortion {
   double k1 = 0.0, k2 = 0.0, p1 = 0.0, p2 = 0.0, k3 = 0.0;
 
   bool is_zero() const { return k1 == 0.0 && k2 == 0.0 && p1 == 0.0 && p2 == 0.0 && k3 == 0.0; }
+
+  // Normalised image coordinates to distorted ones. A template so that the backend's cost functions
+  // differentiate the same formula with Ceres' Jets.
+  template <typename T>
+  void apply(T& x, T& y) const {
+    const T r2 = x * x + y * y;
+    const T radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const T xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+    const T yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+    x = xd;
+    y = yd;
+  }
+  // d(distorted) / d(normalised) at (x, y).
+  Eigen::Matrix2d jacobian(double x, double y) const;
 };
 
 struct PinholeCamera {
@@ -42,5 +56,15 @@ struct PinholeCamera {
            px.y() < height - 0.5 - border;
   }
 };
+
+// The one projection of a point in the camera frame (z != 0) to a pixel: normalised coordinates, the
+// lens distortion, the intrinsics. PinholeCamera::project, the tracker and the backend's cost
+// functions (T = a Ceres Jet) all use it.
+template <typename T>
+Eigen::Matrix<T, 2, 1> project_point(const PinholeCamera& camera, const T& x, const T& y, const T& z) {
+  T xn = x / z, yn = y / z;
+  if (!camera.distortion.is_zero()) camera.distortion.apply(xn, yn);
+  return {camera.fx * xn + camera.cx, camera.fy * yn + camera.cy};
+}
 
 }  // namespace rgbl
