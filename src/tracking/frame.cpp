@@ -56,9 +56,7 @@ void TrackerOptions::validate() const {
 }
 
 void LocalMappingOptions::validate() const {
-  require(min_new_depth_points >= 0, "local_mapping.min_new_depth_points", ">= 0");
-  require(max_new_depth_points >= min_new_depth_points, "local_mapping.max_new_depth_points",
-          ">= min_new_depth_points");
+  require(max_new_depth_points >= 0, "local_mapping.max_new_depth_points", ">= 0");
   require(max_local_ba_keyframes >= 1, "local_mapping.max_local_ba_keyframes", ">= 1");
   require(min_found_ratio >= 0.0 && min_found_ratio <= 1.0, "local_mapping.min_found_ratio", "in [0, 1]");
   require(redundant_ratio > 0.0 && redundant_ratio <= 1.0, "local_mapping.redundant_ratio", "in (0, 1]");

@@ -18,7 +18,6 @@ struct TrackerOptions {
   double motion_ratio = 1.0;            // best/second-best test on the same level (1 = off, as ORB-SLAM)
   double local_map_radius = 3.0;        // px at level 0, local-map search
   int max_hamming = 100;
-  int max_hamming_strict = 50;
   double local_map_ratio = 0.8;
   double reference_ratio = 0.7;         // brute-force fallback against the reference keyframe
   double min_view_cos = 0.5;            // viewing-angle test
@@ -126,8 +125,7 @@ struct TrackerOptions {
 };
 
 struct LocalMappingOptions {
-  int min_new_depth_points = 100;       // at least this many new landmarks from depth per keyframe
-  int max_new_depth_points = 1000;
+  int max_new_depth_points = 1000;      // new landmarks from depth per keyframe, nearest first
   int covisible_for_fusion = 10;
   FusionOptions fusion_match;           // 3 px at level 0, Hamming <= 50
   int max_local_ba_keyframes = 10;      // optimised keyframes (the current one and its best covisible)
