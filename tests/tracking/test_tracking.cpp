@@ -1,4 +1,5 @@
 #include "kitti_run.hpp"
+#include "reliability/failure_run.hpp"
 #include "rgbl/core/error.hpp"
 #include "rgbl/tracking/frame.hpp"
 #include "rgbl/tracking/system.hpp"
@@ -7,6 +8,7 @@
 #include <catch2/catch.hpp>
 #include <opencv2/core.hpp>
 
+#include <cstdint>
 #include <random>
 
 namespace {
@@ -121,6 +123,28 @@ TEST_CASE("deterministic mode: the same input gives a bit-identical trajectory")
   }
   CHECK(a.tracked == 20);
   CHECK(a.ate_rmse < 0.1);
+}
+
+TEST_CASE("relocalisation neither changes nor depends on the caller's OpenCV generator") {
+  const auto sequence = rgbl::test::kitti_seq04();
+  if (!sequence) return;
+  // Frames 0-12, then 4-6 again without a gap in the clock: frame 4 is placed by relocalisation (PnP
+  // RANSAC), run here on the calling thread.
+  const auto steps = rgbl::test::jump(0, 12, 4, 6, true);
+  std::vector<rgbl::TrajectoryPose> first;
+  for (const std::uint64_t seed : {std::uint64_t{1}, std::uint64_t{0x9e3779b97f4a7c15}}) {
+    cv::theRNG().state = seed;
+    const rgbl::test::Outcome o = rgbl::test::run(*sequence, steps);
+    CHECK(cv::theRNG().state == seed);
+    REQUIRE(o.results.size() == steps.size());
+    CHECK(o.results[13].relocalised);
+    if (first.empty()) {
+      first = o.trajectory;
+      continue;
+    }
+    REQUIRE(o.trajectory.size() == first.size());
+    for (std::size_t i = 0; i < first.size(); ++i) CHECK(o.trajectory[i].T_world_cam.matrix() == first[i].T_world_cam.matrix());
+  }
 }
 
 // The threaded-mapping test lives in tests/reliability/test_threaded.cpp (label `threaded`, run under TSan).
