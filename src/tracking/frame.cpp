@@ -16,6 +16,7 @@ void TrackerOptions::validate() const {
   require(max_hamming > 0 && max_hamming <= 256, "tracker.max_hamming", "in (0, 256]");
   require(local_map_ratio > 0.0 && local_map_ratio <= 1.0, "tracker.local_map_ratio", "in (0, 1]");
   require(reference_ratio > 0.0 && reference_ratio <= 1.0, "tracker.reference_ratio", "in (0, 1]");
+  require(reference_min_matches >= 3, "tracker.reference_min_matches", ">= 3 (a pose needs 3 points)");
   require(max_local_keyframes >= 1, "tracker.max_local_keyframes", ">= 1");
   require(min_pose_inliers >= 3, "tracker.min_pose_inliers", ">= 3");
   require(verify_min_found_ratio >= 0.0 && verify_min_found_ratio <= 1.0, "tracker.verify_min_found_ratio",
@@ -25,6 +26,11 @@ void TrackerOptions::validate() const {
   require(relocalisation_min_found_ratio >= 0.0 && relocalisation_min_found_ratio <= 1.0,
           "tracker.relocalisation_min_found_ratio", "in [0, 1]");
   require(relocalisation_min_matches >= 6, "tracker.relocalisation_min_matches", ">= 6 (PnP RANSAC)");
+  require(relocalisation_ratio > 0.0 && relocalisation_ratio <= 1.0, "tracker.relocalisation_ratio", "in (0, 1]");
+  require(relocalisation_ransac_iterations >= 1, "tracker.relocalisation_ransac_iterations", ">= 1");
+  require(relocalisation_ransac_px > 0.0, "tracker.relocalisation_ransac_px", "> 0 px");
+  require(relocalisation_ransac_confidence > 0.0 && relocalisation_ransac_confidence < 1.0,
+          "tracker.relocalisation_ransac_confidence", "in (0, 1)");
   require(ransac_iterations >= 1, "tracker.ransac_iterations", ">= 1");
   require(ransac_min_inliers >= 3, "tracker.ransac_min_inliers", ">= 3 (a rigid motion needs 3 points)");
   require(ransac_guess_min_inliers >= 3, "tracker.ransac_guess_min_inliers", ">= 3 (a rigid motion needs 3 points)");
@@ -51,6 +57,12 @@ void TrackerOptions::validate() const {
           "tracker.step_tolerance_rotation_deg", "in [0, 180] degrees");
   require(min_jump_inliers >= min_pose_inliers, "tracker.min_jump_inliers", ">= tracker.min_pose_inliers");
   require(max_frames_between_keyframes >= 1, "tracker.max_frames_between_keyframes", ">= 1");
+  require(reference_ratio_threshold > 0.0 && reference_ratio_threshold <= 1.0, "tracker.reference_ratio_threshold",
+          "in (0, 1]");
+  require(initial_reference_ratio_threshold > 0.0 && initial_reference_ratio_threshold <= 1.0,
+          "tracker.initial_reference_ratio_threshold", "in (0, 1]");
+  require(urgent_reference_ratio >= 0.0 && urgent_reference_ratio <= 1.0, "tracker.urgent_reference_ratio",
+          "in [0, 1] (0 = off)");
   require(close_depth > 0.0, "tracker.close_depth", "> 0");
   pose.validate();
 }

@@ -437,7 +437,7 @@ bool Tracker::track_reference_keyframe(Frame& frame) {
   }
   const auto matches =
       detail::match_brute_force(frame.descriptors, train, options_.max_hamming, options_.reference_ratio);
-  if (static_cast<int>(matches.size()) < 15) return false;
+  if (static_cast<int>(matches.size()) < options_.reference_min_matches) return false;
   for (const auto& [q, t] : matches) frame.landmarks[static_cast<std::size_t>(q)] = train_landmarks[static_cast<std::size_t>(t)];
   // Start from the frame-to-frame motion from depth where there is one (the frame right after
   // initialisation has no velocity yet, and the last pose is then a poor guess at speed).
@@ -586,7 +586,8 @@ bool Tracker::relocalise(Frame& frame) {
       positions.push_back(l->position);
     }
   }
-  const auto matches = detail::match_brute_force(frame.descriptors, train, options_.max_hamming, 0.75);
+  const auto matches =
+      detail::match_brute_force(frame.descriptors, train, options_.max_hamming, options_.relocalisation_ratio);
   // A hypothesis needs only a few matches: the map-wide ratio test keeps few of them. It is accepted
   // only when the local-map search from its pose then finds min_ok_inliers_after_relocalisation (as ORB-SLAM).
   if (static_cast<int>(matches.size()) < options_.relocalisation_min_matches) return false;
@@ -602,8 +603,10 @@ bool Tracker::relocalise(Frame& frame) {
   std::vector<int> inlier_indices;
   // Deterministic without touching the caller's cv::theRNG(): OpenCV's RANSAC (non-USAC flags) draws
   // from its own fixed-seed generator (tests/tracking checks both).
-  if (!cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, false, 300, 4.0F, 0.99, inlier_indices,
-                          cv::SOLVEPNP_EPNP)) {
+  if (!cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, false,
+                          options_.relocalisation_ransac_iterations,
+                          static_cast<float>(options_.relocalisation_ransac_px),
+                          options_.relocalisation_ransac_confidence, inlier_indices, cv::SOLVEPNP_EPNP)) {
     return false;
   }
   if (static_cast<int>(inlier_indices.size()) < options_.min_pose_inliers) return false;
@@ -645,10 +648,10 @@ bool Tracker::need_keyframe(const Frame& frame, int inliers, bool mapping_idle) 
   }
   const bool need_close =
       tracked_close < options_.close_tracked_threshold && untracked_close > options_.close_untracked_threshold;
-  const double ratio = keyframes < 2 ? 0.4 : options_.reference_ratio_threshold;
+  const double ratio = keyframes < 2 ? options_.initial_reference_ratio_threshold : options_.reference_ratio_threshold;
   const bool c1a = since_last >= options_.max_frames_between_keyframes;
   const bool c1b = mapping_idle;
-  const bool c1c = inliers < 0.25 * reference_matches || need_close;
+  const bool c1c = inliers < options_.urgent_reference_ratio * reference_matches || need_close;
   const bool c2 = (inliers < ratio * reference_matches || need_close) && inliers > options_.min_keyframe_inliers;
   return (c1a || c1b || c1c) && c2;
 }

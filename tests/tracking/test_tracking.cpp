@@ -78,6 +78,12 @@ TEST_CASE("system: configuration errors name the key; no depth keeps it uninitia
   verify = {};
   verify.verify_min_motion_ratio = -0.1;
   CHECK_THROWS_WITH(verify.validate(), Catch::Contains("tracker.verify_min_motion_ratio"));
+  verify = {};
+  verify.relocalisation_ransac_px = 0.0;
+  CHECK_THROWS_WITH(verify.validate(), Catch::Contains("tracker.relocalisation_ransac_px"));
+  verify = {};
+  verify.urgent_reference_ratio = 1.5;
+  CHECK_THROWS_WITH(verify.validate(), Catch::Contains("tracker.urgent_reference_ratio"));
 
   rgbl::OrbExtractor orb;
   rgbl::System system({}, small_camera(), std::make_unique<NoDepth>(),
@@ -143,7 +149,9 @@ TEST_CASE("relocalisation neither changes nor depends on the caller's OpenCV gen
       continue;
     }
     REQUIRE(o.trajectory.size() == first.size());
-    for (std::size_t i = 0; i < first.size(); ++i) CHECK(o.trajectory[i].T_world_cam.matrix() == first[i].T_world_cam.matrix());
+    for (std::size_t i = 0; i < first.size(); ++i) {
+      CHECK(o.trajectory[i].T_world_cam.matrix() == first[i].T_world_cam.matrix());
+    }
   }
 }
 

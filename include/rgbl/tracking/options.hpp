@@ -20,9 +20,16 @@ struct TrackerOptions {
   int max_hamming = 100;
   double local_map_ratio = 0.8;
   double reference_ratio = 0.7;         // brute-force fallback against the reference keyframe
+  int reference_min_matches = 15;       // ...and the matches it needs to try a pose (ORB-SLAM's 15)
   double min_view_cos = 0.5;            // viewing-angle test
   int max_local_keyframes = 80;
   int min_pose_inliers = 10;            // pose optimisation success
+  // Relocalisation: brute-force matches against every landmark with ORB-SLAM's ratio, then PnP RANSAC
+  // (EPnP) on them with ORB-SLAM's iterations and confidence (it stops early once that sure).
+  double relocalisation_ratio = 0.75;
+  int relocalisation_ransac_iterations = 300;
+  double relocalisation_ransac_px = 4.0;  // inlier reprojection error
+  double relocalisation_ransac_confidence = 0.99;
   int relocalisation_min_matches = 15;  // map-wide descriptor matches to try a relocalisation (PnP RANSAC)
   // ...and the share of the local-map points predicted visible that the search re-finds (judged where
   // that means at least min_pose_inliers points). On KITTI 04's repetitive road wrong relocalisations
@@ -115,6 +122,10 @@ struct TrackerOptions {
   // Keyframe decision (SPEC section 5)
   int max_frames_between_keyframes = 10;
   double reference_ratio_threshold = 0.75;
+  double initial_reference_ratio_threshold = 0.4;  // ...while the map has one keyframe (ORB-SLAM's values)
+  // Tracking fewer than this share of the reference keyframe's points makes a keyframe due without
+  // waiting for max_frames_between_keyframes or idle mapping (ORB-SLAM's 0.25 for depth cameras).
+  double urgent_reference_ratio = 0.25;
   int close_tracked_threshold = 100, close_untracked_threshold = 70;
   int min_keyframe_inliers = 15;
   double close_depth = 97.0;            // m; "close" points (RGB-L: bf/fx * ThDepth = 100/707 * 700)
