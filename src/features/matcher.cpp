@@ -92,7 +92,6 @@ struct BruteForceScan {
   std::span<const Descriptor> query, train;
   bool cross_check;
   std::vector<Match>& nearest;
-  std::vector<int>& second_of;
   std::vector<int>& train_best;
   std::vector<int>& train_best_query;
 };
@@ -127,8 +126,7 @@ struct BruteForceScan {
         s.train_best_query[ti] = static_cast<int>(qi);
       }
     }
-    s.nearest[qi] = {static_cast<int>(qi), best_index, best};
-    s.second_of[qi] = second;
+    s.nearest[qi] = {static_cast<int>(qi), best_index, best, second};
   }
 }
 
@@ -222,38 +220,51 @@ std::vector<int> match_guided(std::span<const GuidedQuery> queries, const Featur
   }
 
   if (options.check_orientation) {
-    const int bins = options.histogram_bins;
-    const float bin_width = 360.0F / static_cast<float>(bins);
-    std::vector<int> bin_of(queries.size(), -1);
-    std::vector<int> counts(static_cast<std::size_t>(bins), 0);
+    std::vector<std::size_t> matched;
+    std::vector<float> rotations;
     for (std::size_t qi = 0; qi < queries.size(); ++qi) {
       if (result[qi] < 0) continue;
-      float rot = queries[qi].angle - keypoints[static_cast<std::size_t>(result[qi])].angle;
-      rot = std::fmod(rot, 360.0F);
-      if (rot < 0.0F) rot += 360.0F;
-      int bin = static_cast<int>(std::lround(rot / bin_width));
-      if (bin >= bins) bin -= bins;
-      bin_of[qi] = bin;
-      ++counts[static_cast<std::size_t>(bin)];
+      matched.push_back(qi);
+      rotations.push_back(queries[qi].angle - keypoints[static_cast<std::size_t>(result[qi])].angle);
     }
-    // The keep_bins fullest bins (ties: lower bin), each kept only with >= 10% of the fullest count.
-    std::vector<int> order(static_cast<std::size_t>(bins));
-    for (int b = 0; b < bins; ++b) order[static_cast<std::size_t>(b)] = b;
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-      return counts[static_cast<std::size_t>(a)] > counts[static_cast<std::size_t>(b)];
-    });
-    std::vector<char> keep(static_cast<std::size_t>(bins), 0);
-    const int top = counts[static_cast<std::size_t>(order[0])];
-    for (int k = 0; k < options.keep_bins; ++k) {
-      const int b = order[static_cast<std::size_t>(k)];
-      const int c = counts[static_cast<std::size_t>(b)];
-      if (c > 0 && 10 * c >= top) keep[static_cast<std::size_t>(b)] = 1;
-    }
-    for (std::size_t qi = 0; qi < queries.size(); ++qi) {
-      if (bin_of[qi] >= 0 && keep[static_cast<std::size_t>(bin_of[qi])] == 0) result[qi] = -1;
+    const std::vector<char> keep = rotation_consistent(rotations, options.histogram_bins, options.keep_bins);
+    for (std::size_t i = 0; i < matched.size(); ++i) {
+      if (keep[i] == 0) result[matched[i]] = -1;
     }
   }
   return result;
+}
+
+std::vector<char> rotation_consistent(std::span<const float> rotations, int bins, int keep_bins) {
+  require(bins > 0, "rotation_consistent.bins", "> 0");
+  require(keep_bins > 0 && keep_bins <= bins, "rotation_consistent.keep_bins", "in [1, bins]");
+  const float bin_width = 360.0F / static_cast<float>(bins);
+  std::vector<int> bin_of(rotations.size());
+  std::vector<int> counts(static_cast<std::size_t>(bins), 0);
+  for (std::size_t i = 0; i < rotations.size(); ++i) {
+    float rot = std::fmod(rotations[i], 360.0F);
+    if (rot < 0.0F) rot += 360.0F;
+    int bin = static_cast<int>(std::lround(rot / bin_width));
+    if (bin >= bins) bin -= bins;
+    bin_of[i] = bin;
+    ++counts[static_cast<std::size_t>(bin)];
+  }
+  // The keep_bins fullest bins (ties: lower bin), each kept only with >= 10% of the fullest count.
+  std::vector<int> order(static_cast<std::size_t>(bins));
+  for (int b = 0; b < bins; ++b) order[static_cast<std::size_t>(b)] = b;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return counts[static_cast<std::size_t>(a)] > counts[static_cast<std::size_t>(b)];
+  });
+  std::vector<char> keep_bin(static_cast<std::size_t>(bins), 0);
+  const int top = counts[static_cast<std::size_t>(order[0])];
+  for (int k = 0; k < keep_bins; ++k) {
+    const int b = order[static_cast<std::size_t>(k)];
+    const int c = counts[static_cast<std::size_t>(b)];
+    if (c > 0 && 10 * c >= top) keep_bin[static_cast<std::size_t>(b)] = 1;
+  }
+  std::vector<char> keep(rotations.size());
+  for (std::size_t i = 0; i < rotations.size(); ++i) keep[i] = keep_bin[static_cast<std::size_t>(bin_of[i])];
+  return keep;
 }
 
 std::vector<Match> match_brute_force(std::span<const Descriptor> query, std::span<const Descriptor> train,
@@ -266,8 +277,7 @@ std::vector<Match> match_brute_force(std::span<const Descriptor> query, std::spa
   std::vector<int> train_best(options.cross_check ? train.size() : 0, kNone);
   std::vector<int> train_best_query(train_best.size(), -1);
   std::vector<Match> nearest(query.size());
-  std::vector<int> second_of(query.size(), kNone);
-  BruteForceScan scan{query, train, options.cross_check, nearest, second_of, train_best, train_best_query};
+  BruteForceScan scan{query, train, options.cross_check, nearest, train_best, train_best_query};
 #if defined(RGBL_HAVE_POPCNT_PATH)
   if (cpu_has_popcnt()) {
     scan_with_popcnt(scan);
@@ -278,7 +288,7 @@ std::vector<Match> match_brute_force(std::span<const Descriptor> query, std::spa
   }
   for (std::size_t qi = 0; qi < query.size(); ++qi) {
     const Match& m = nearest[qi];
-    if (m.distance > options.max_distance || !passes_ratio(m.distance, second_of[qi], options.ratio)) continue;
+    if (m.distance > options.max_distance || !passes_ratio(m.distance, m.second_distance, options.ratio)) continue;
     if (options.cross_check && train_best_query[static_cast<std::size_t>(m.train)] != m.query) continue;
     matches.push_back(m);
   }

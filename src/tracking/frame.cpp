@@ -14,6 +14,8 @@ void TrackerOptions::validate() const {
   require(motion_radius > 0.0, "tracker.motion_radius", "> 0");
   require(local_map_radius > 0.0, "tracker.local_map_radius", "> 0");
   require(max_hamming > 0 && max_hamming <= 256, "tracker.max_hamming", "in (0, 256]");
+  require(motion_max_hamming > 0 && motion_max_hamming <= 256, "tracker.motion_max_hamming", "in (0, 256]");
+  require(ransac_max_hamming > 0 && ransac_max_hamming <= 256, "tracker.ransac_max_hamming", "in (0, 256]");
   require(local_map_ratio > 0.0 && local_map_ratio <= 1.0, "tracker.local_map_ratio", "in (0, 1]");
   require(reference_ratio > 0.0 && reference_ratio <= 1.0, "tracker.reference_ratio", "in (0, 1]");
   require(reference_min_matches >= 3, "tracker.reference_min_matches", ">= 3 (a pose needs 3 points)");

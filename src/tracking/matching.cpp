@@ -1,10 +1,8 @@
 #include "matching.hpp"
 
+#include "rgbl/features/matcher.hpp"
+
 #include <algorithm>
-#include <bit>
-#include <cstdint>
-#include <cstring>
-#include <array>
 #include <climits>
 #include <cmath>
 
@@ -46,37 +44,23 @@ int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates,
     best_distance[k] = best;
     owner[k] = static_cast<int>(c);
   }
-  // Rotation consistency: keep the three dominant bins of angle differences.
-  constexpr int kBins = 30;
-  std::array<std::vector<std::size_t>, kBins> bins;
-  std::vector<std::size_t> matched;
+  // Rotation consistency over the matches whose candidate's angle is known.
+  std::vector<std::size_t> matched, rotated;
+  std::vector<float> rotations;
   for (std::size_t k = 0; k < n; ++k) {
     if (owner[k] < 0) continue;
     matched.push_back(k);
     const ProjectedLandmark& cand = candidates[static_cast<std::size_t>(owner[k])];
     if (check_orientation && cand.angle >= 0.0F) {
-      float rot = cand.angle - frame.keypoints[k].angle;
-      if (rot < 0.0F) rot += 360.0F;
-      const int bin = std::min(kBins - 1, static_cast<int>(std::lround(rot * kBins / 360.0F)) % kBins);
-      bins[static_cast<std::size_t>(bin)].push_back(k);
+      rotated.push_back(k);
+      rotations.push_back(cand.angle - frame.keypoints[k].angle);
     }
   }
   std::vector<char> keep(n, 1);
   if (check_orientation) {
-    std::array<int, kBins> order{};
-    for (int i = 0; i < kBins; ++i) order[static_cast<std::size_t>(i)] = i;
-    std::sort(order.begin(), order.end(), [&](int a, int b) {
-      const auto sa = bins[static_cast<std::size_t>(a)].size(), sb = bins[static_cast<std::size_t>(b)].size();
-      return sa != sb ? sa > sb : a < b;
-    });
-    const std::size_t top = bins[static_cast<std::size_t>(order[0])].size();
-    for (int r = 0; r < kBins; ++r) {
-      const auto& bin = bins[static_cast<std::size_t>(order[static_cast<std::size_t>(r)])];
-      const bool dominant = r < 3 && static_cast<double>(bin.size()) >= 0.1 * static_cast<double>(top);
-      if (!dominant) {
-        for (const std::size_t k : bin) keep[k] = 0;
-      }
-    }
+    const GuidedMatchOptions histogram;  // the features module's bins (ORB-SLAM's 30, 3 kept)
+    const std::vector<char> consistent = rotation_consistent(rotations, histogram.histogram_bins, histogram.keep_bins);
+    for (std::size_t i = 0; i < rotated.size(); ++i) keep[rotated[i]] = consistent[i];
   }
   int count = 0;
   if (candidate_of_keypoint != nullptr) candidate_of_keypoint->assign(n, -1);
@@ -94,28 +78,20 @@ int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates,
 std::vector<std::pair<int, int>> match_brute_force(std::span<const Descriptor> query,
                                                    std::span<const Descriptor> train, int max_hamming,
                                                    double ratio) {
-  std::vector<std::pair<int, int>> matches;
+  BruteForceMatchOptions options;
+  options.max_distance = max_hamming;
+  options.ratio = 1.0F;  // the tracker's own test below: best <= ratio * second, in double
   std::vector<int> best_for_train(train.size(), INT_MAX);
   std::vector<int> query_for_train(train.size(), -1);
-  for (std::size_t q = 0; q < query.size(); ++q) {
-    int best = INT_MAX, second = INT_MAX, best_index = -1;
-    for (std::size_t t = 0; t < train.size(); ++t) {
-      const int d = hamming_distance(query[q], train[t]);
-      if (d < best) {
-        second = best;
-        best = d;
-        best_index = static_cast<int>(t);
-      } else if (d < second) {
-        second = d;
-      }
-    }
-    if (best_index < 0 || best > max_hamming || best > ratio * second) continue;
-    const auto t = static_cast<std::size_t>(best_index);
-    if (best < best_for_train[t]) {
-      best_for_train[t] = best;
-      query_for_train[t] = static_cast<int>(q);
+  for (const Match& m : rgbl::match_brute_force(query, train, options)) {  // ascending query
+    if (m.distance > ratio * m.second_distance) continue;
+    const auto t = static_cast<std::size_t>(m.train);
+    if (m.distance < best_for_train[t]) {
+      best_for_train[t] = m.distance;
+      query_for_train[t] = m.query;
     }
   }
+  std::vector<std::pair<int, int>> matches;
   for (std::size_t t = 0; t < train.size(); ++t) {
     if (query_for_train[t] >= 0) matches.emplace_back(query_for_train[t], static_cast<int>(t));
   }

@@ -37,7 +37,8 @@ int match_projected(Frame& frame, std::span<const ProjectedLandmark> candidates,
                     bool check_orientation, std::vector<int>* candidate_of_keypoint = nullptr,
                     DepthGate gate = {});
 
-// query index -> train index, best match with a ratio test.
+// query index -> train index: features' brute-force nearest neighbour with the tracker's ratio test
+// (best <= ratio * second best) and each train descriptor kept by its nearest query (ties: the lower).
 std::vector<std::pair<int, int>> match_brute_force(std::span<const Descriptor> query,
                                                    std::span<const Descriptor> train, int max_hamming,
                                                    double ratio);

@@ -4,7 +4,9 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <limits>
 #include <random>
+#include <vector>
 
 namespace {
 
@@ -262,7 +264,36 @@ TEST_CASE("brute-force matcher: known permutation, ratio test, cross check", "[f
   CHECK(matches[0].query == 0);
   CHECK(matches[0].train == 0);
   CHECK(matches[0].distance == 10);
+  // The second-nearest distance, for a caller's own ratio test (INT_MAX: no second train descriptor).
+  CHECK(matches[0].second_distance == rgbl::hamming_distance(q2[0], t2[1]));
+  const std::vector<rgbl::Descriptor> t1{train[0]};
+  matches = rgbl::match_brute_force(q2, t1, options);
+  REQUIRE(matches.size() == 1);
+  CHECK(matches[0].second_distance == std::numeric_limits<int>::max());
   CHECK(rgbl::match_brute_force({}, t2, options).empty());
+}
+
+TEST_CASE("rotation consistency keeps the fullest bins holding >= 10 % of the top one", "[features][matcher]") {
+  // 30 bins of 12 deg centred on multiples of 12: 40 and -320 -> bin 3, 52 -> 4, 200 -> 17, 100 -> 8,
+  // 359 -> 30, which wraps to 0.
+  std::vector<float> rotations;
+  for (int i = 0; i < 20; ++i) rotations.push_back(i % 2 == 0 ? 40.0F : -320.0F);
+  for (int i = 0; i < 3; ++i) rotations.push_back(52.0F);
+  for (int i = 0; i < 2; ++i) rotations.push_back(200.0F);  // exactly 10 % of the fullest
+  rotations.push_back(100.0F);
+  rotations.push_back(359.0F);
+  std::vector<char> expected(rotations.size(), 1);
+  expected[25] = expected[26] = 0;  // bins 8 and 0: not among the 3 fullest
+  CHECK(rgbl::rotation_consistent(rotations, 30, 3) == expected);
+  rotations.push_back(40.0F);  // the fullest bin grows to 21: bin 17 is below 10 %
+  expected[23] = expected[24] = 0;
+  expected.push_back(1);
+  CHECK(rgbl::rotation_consistent(rotations, 30, 3) == expected);
+  // keep_bins = 1: only the fullest bin; 359 deg is in bin 0 (wrapped), i.e. next to 0 deg.
+  const std::vector<float> around_zero{359.0F, 1.0F, 5.9F, 6.1F};
+  CHECK(rgbl::rotation_consistent(around_zero, 30, 1) == std::vector<char>{1, 1, 1, 0});
+  CHECK(rgbl::rotation_consistent({}, 30, 3).empty());
+  CHECK_THROWS_WITH(rgbl::rotation_consistent(around_zero, 30, 31), Catch::Contains("rotation_consistent.keep_bins"));
 }
 
 TEST_CASE("matcher options validation names the key", "[features][matcher]") {

@@ -54,9 +54,7 @@ struct GuidedMatchOptions {
   // on the same pyramid level as the best (a near-duplicate at another scale is the same structure,
   // not an ambiguity). ratio = 1 disables the test.
   float ratio = 0.8F;
-  // Rotation-consistency: histogram of (query.angle - keypoint.angle) in `histogram_bins` bins; only
-  // matches in the `keep_bins` fullest bins survive, and of those only bins holding at least 10% of
-  // the fullest one (ORB-SLAM's rule).
+  // Rotation consistency of the matches (rotation_consistent below, with query.angle - keypoint.angle).
   bool check_orientation = true;
   int histogram_bins = 30;
   int keep_bins = 3;
@@ -69,6 +67,12 @@ std::vector<int> match_guided(std::span<const GuidedQuery> queries, const Featur
                               std::span<const Keypoint> keypoints, std::span<const Descriptor> descriptors,
                               const GuidedMatchOptions& options);
 
+// Rotation consistency (ORB-SLAM's rule): rotations[i] is match i's angle difference in degrees (any
+// sign), binned in `bins` bins of 360 / bins degrees centred on multiples of the width. A match is kept
+// (1) when its bin is one of the keep_bins fullest (ties: the lower bin) and holds at least 10 % of the
+// fullest bin's matches: one rigid image rotation moves every keypoint's angle alike.
+std::vector<char> rotation_consistent(std::span<const float> rotations, int bins, int keep_bins);
+
 struct BruteForceMatchOptions {
   int max_distance = 100;   // Hamming, inclusive
   float ratio = 0.7F;       // best < ratio * second best over all train descriptors; 1 disables
@@ -80,6 +84,7 @@ struct Match {
   int query = -1;
   int train = -1;
   int distance = 0;
+  int second_distance = 0;  // to the second-nearest train descriptor (INT_MAX: none), for own ratio tests
 };
 
 // Nearest train descriptor for every query that passes the distance, ratio (and cross) checks, in
