@@ -159,8 +159,6 @@ int LocalMapper::local_bundle_adjustment(KeyframeId id, double& elapsed_ms) {
 
 int LocalMapper::cull_keyframes(KeyframeId id) {
   int culled = 0;
-  const double scale = map_.options().scale_factor;
-  (void)scale;
   for (const KeyframeId k : map_.best_covisible(id, 100)) {
     if (k.value == 0 || k == id) continue;
     const Keyframe* kf = map_.keyframe(k);

@@ -543,7 +543,7 @@ Tracker::LocalMapResult Tracker::track_local_map(Frame& frame) {
       c.descriptor = l->descriptor;
       c.x = static_cast<float>(view->pixel.x());
       c.y = static_cast<float>(view->pixel.y());
-      c.radius = static_cast<float>(options_.local_map_radius * std::pow(map_options.scale_factor, view->level));
+      c.radius = static_cast<float>(options_.local_map_radius * level_scale(map_, view->level));
       c.min_level = std::max(0, view->level - 1);
       c.max_level = view->level;
       c.depth = static_cast<float>(view->p_cam.z());
