@@ -5,6 +5,8 @@
 #include "support/temp_dir.hpp"
 
 #include <catch2/catch.hpp>
+
+#include <array>
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
 
@@ -151,4 +153,47 @@ TEST_CASE("real KITTI seq 04: all 51 scans into camera 2") {
   INFO("mean fill " << mean_fill);
   CHECK(mean_fill > 0.03);
   CHECK(mean_fill < 0.05);
+}
+
+namespace {
+
+struct DoublePoint {  // x, y, z of another type, no intensity
+  double x, y, z;
+};
+
+struct OtherNames {  // a type the primary traits cannot read
+  std::array<float, 3> pos;
+  float reflectivity;
+};
+
+}  // namespace
+
+template <>
+struct rgbl::PointTraits<OtherNames> {
+  static Eigen::Vector3d position(const OtherNames& p) { return {p.pos[0], p.pos[1], p.pos[2]}; }
+  static float intensity(const OtherNames& p) { return p.reflectivity; }
+};
+
+TEST_CASE("foreign point types reach the kernels through PointTraits") {
+  const std::vector<DoublePoint> doubles = {{0.0, 0.0, 10.0}, {1.0, -0.4, 20.0}};
+  std::vector<rgbl::LidarPoint> points(7);  // reused, not appended to
+  rgbl::to_lidar_points(doubles, points);
+  REQUIRE(points.size() == 2);
+  CHECK(points[1].x == 1.0F);
+  CHECK(points[1].y == -0.4F);
+  CHECK(points[1].z == 20.0F);
+  CHECK(points[1].intensity == 0.0F);
+  const OtherNames other[] = {{{0.0F, 0.0F, 10.0F}, 0.7F}, {{1.0F, -0.4F, 20.0F}, 0.2F}};
+  std::vector<rgbl::LidarPoint> converted;
+  rgbl::to_lidar_points(other, converted);
+  REQUIRE(converted.size() == 2);
+  CHECK(converted[0].intensity == 0.7F);
+  CHECK(converted[1].z == 20.0F);
+  rgbl::Matrix34d P;
+  P << 100.0, 0.0, 32.0, 0.0, 0.0, 100.0, 24.0, 0.0, 0.0, 0.0, 1.0, 0.0;
+  const cv::Mat_<float> a = rgbl::project_to_depth(points, P, 64, 48, {1.0F, 100.0F});
+  const cv::Mat_<float> b = rgbl::project_to_depth(converted, P, 64, 48, {1.0F, 100.0F});
+  CHECK(a(24, 32) == 10.0F);
+  CHECK(a(22, 37) == 20.0F);  // (1, -0.4, 20): u = 32 + 100 / 20, v = 24 - 40 / 20
+  CHECK(cv::countNonZero(a != b) == 0);
 }
