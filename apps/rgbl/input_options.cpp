@@ -82,6 +82,7 @@ void add_input_options(CLI::App& app, PipelineOptions& options) {
 }
 
 RunResult run_and_report(const Pipeline& pipeline, const std::filesystem::path& out_dir, bool quiet) {
+  remove_run_outputs(out_dir);  // an earlier run's files would look like this one's if it fails
   for (const auto& note : pipeline.notes()) fmt::print(stderr, "note: {}\n", note);
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   Stopwatch wall, clock;
