@@ -16,18 +16,12 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
-#include <algorithm>
-#include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <memory>
-#include <numbers>
 #include <optional>
 #include <string>
-#include <system_error>
-#include <vector>
 
 namespace rgbl::cli {
 namespace {
@@ -73,8 +67,7 @@ int run_demo(const DemoArgs& args, bool quiet) {
   if (sim.path.kind == PathKind::loop) fit_loop(sim, args.laps);
 
   // refuse what cannot work before spending the generation time on it (the layout has no depth camera)
-  const std::string spec = args.depth == "precomputed" ? "precomputed:exact" : args.depth;
-  const DepthSourceNeeds needs = builtin_depth_sources().entry(spec).needs;
+  const DepthSourceNeeds needs = builtin_depth_sources().entry(args.depth).needs;
   if (needs.depth_image) {
     throw ConfigError("--depth", fmt::format("lidar[:...], stereo or precomputed[:<dir>] for the demo's KITTI layout "
                                              "(it has no depth-camera images; `precomputed` reads the exact depth), "

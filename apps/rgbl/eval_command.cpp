@@ -1,6 +1,5 @@
 // rgbl eval <estimate> <ground-truth>: KITTI odometry metric, ATE, RPE and end-point drift.
 #include "command.hpp"
-#include "rgbl/core/error.hpp"
 #include "rgbl/core/file.hpp"
 #include "rgbl/pipeline/compare.hpp"
 
@@ -8,12 +7,10 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
-#include <vector>
 
 namespace rgbl::cli {
 namespace {

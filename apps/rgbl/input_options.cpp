@@ -3,32 +3,27 @@
 #include "rgbl/core/timer.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <cstdio>
-#include <string>
 
 namespace rgbl::cli {
 namespace {
 
 void print_summary(const RunResult& run, const std::filesystem::path& out_dir) {
   const RunTimings t = run.timings();
-  const auto frames = [&run](auto&& selected) {
-    std::string list;
-    for (const auto& r : run.frames) {
-      if (selected(r.result)) list += (list.empty() ? "" : ", ") + std::to_string(r.result.frame_index);
-    }
-    return list;
-  };
   fmt::print("\n{} ({}), camera {}, depth {}: {} frames in {:.1f} s\n", run.sequence_name, to_string(run.format),
              run.camera, run.depth, run.frames.size(), run.wall_s);
   fmt::print("  ok {}, weak {}, lost {}, not initialised {}; {} keyframes, {} landmarks\n",
              run.count(TrackState::Ok), run.count(TrackState::Weak), run.count(TrackState::Lost),
              run.count(TrackState::NotInitialised), run.keyframe_count(), run.landmarks.size());
-  const std::string jumps = frames([](const TrackResult& r) { return r.jump; });
-  const std::string new_maps = frames([](const TrackResult& r) { return r.new_map; });
-  if (!jumps.empty()) fmt::print("  steps beyond a vehicle's reach taken at frame(s) {}\n", jumps);
-  if (!new_maps.empty()) fmt::print("  lost beyond relocalisation: new map started at frame(s) {}\n", new_maps);
+  const auto jumps = run.frames_where([](const TrackResult& r) { return r.jump; });
+  const auto new_maps = run.frames_where([](const TrackResult& r) { return r.new_map; });
+  if (!jumps.empty()) fmt::print("  steps beyond a vehicle's reach taken at frame(s) {}\n", fmt::join(jumps, ", "));
+  if (!new_maps.empty()) {
+    fmt::print("  lost beyond relocalisation: new map started at frame(s) {}\n", fmt::join(new_maps, ", "));
+  }
   if (run.loop_statistics.implausible > 0) {
     fmt::print("  loop closing refused {} verified loop(s) asking for more correction than odometry can drift\n",
                run.loop_statistics.implausible);

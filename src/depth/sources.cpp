@@ -337,9 +337,10 @@ void apply_lidar_argument(std::string_view argument, LidarSourceOptions& options
 
 namespace {
 
-// An entry for a source that takes no argument.
-template <typename Options, typename Make>
-DepthSourceEntry plain_entry(const char* name, DepthSourceNeeds needs, Options options, Make make) {
+// An entry for a source that takes no argument, made by `make` (one of the make_*_source above).
+template <typename Options>
+DepthSourceEntry plain_entry(const char* name, DepthSourceNeeds needs, Options options,
+                             std::unique_ptr<DepthSource> (*make)(const Options&, const DepthSourceContext&)) {
   return {needs, name, [name, options, make](std::string_view argument, const DepthSourceContext& context) {
             if (!argument.empty()) throw ConfigError("--depth", fmt::format("'{}' without an argument", name));
             return make(options, context);
@@ -349,9 +350,7 @@ DepthSourceEntry plain_entry(const char* name, DepthSourceNeeds needs, Options o
 }  // namespace
 
 DepthSourceEntry lidar_depth_source(LidarSourceOptions options) {
-  DepthSourceNeeds needs;
-  needs.scan = true;
-  return {needs, "lidar[:dilated|ipbasic|ipbasic-multiscale|<diamond|rectangle|cross><size>]",
+  return {{.scan = true}, "lidar[:dilated|ipbasic|ipbasic-multiscale|<diamond|rectangle|cross><size>]",
           [options](std::string_view argument, const DepthSourceContext& context) {
             LidarSourceOptions o = options;
             apply_lidar_argument(argument, o);
@@ -370,28 +369,15 @@ DepthSourceEntry precomputed_depth_source(PrecomputedSourceOptions options) {
 }
 
 DepthSourceEntry stereo_depth_source(StereoSourceOptions options) {
-  DepthSourceNeeds needs;
-  needs.right_image = true;
-  return plain_entry("stereo", needs, options, [](const StereoSourceOptions& o, const DepthSourceContext& c) {
-    return make_stereo_source(o, c);
-  });
+  return plain_entry("stereo", {.right_image = true}, options, &make_stereo_source);
 }
 
 DepthSourceEntry stereo_sparse_depth_source(StereoSparseSourceOptions options) {
-  DepthSourceNeeds needs;
-  needs.right_image = true;
-  return plain_entry("stereo_sparse", needs, options,
-                     [](const StereoSparseSourceOptions& o, const DepthSourceContext& c) {
-                       return make_stereo_sparse_source(o, c);
-                     });
+  return plain_entry("stereo_sparse", {.right_image = true}, options, &make_stereo_sparse_source);
 }
 
 DepthSourceEntry rgbd_depth_source(RgbdSourceOptions options) {
-  DepthSourceNeeds needs;
-  needs.depth_image = true;
-  return plain_entry("rgbd", needs, options, [](const RgbdSourceOptions& o, const DepthSourceContext& c) {
-    return make_rgbd_source(o, c);
-  });
+  return plain_entry("rgbd", {.depth_image = true}, options, &make_rgbd_source);
 }
 
 DepthSourceRegistry builtin_depth_sources() {

@@ -3,8 +3,9 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/io/trajectory_io.hpp"
 
+#include "json.hpp"
+
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <fstream>
@@ -12,9 +13,8 @@
 namespace rgbl {
 namespace {
 
-using Json = nlohmann::ordered_json;
-
-Json number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+using detail::Json;
+constexpr auto number = detail::json_number;
 
 Json stats_json(const ErrorStats& s) {
   return {{"rmse", number(s.rmse)}, {"mean", number(s.mean)}, {"median", number(s.median)}, {"max", number(s.max)}};

@@ -3,7 +3,6 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/timer.hpp"
 #include "rgbl/depth/completion.hpp"
-#include "rgbl/io/read_ahead.hpp"
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
@@ -85,11 +84,7 @@ DepthExportResult export_depth(const Pipeline& p, const std::filesystem::path& o
   accumulation.projection = p.lidar_options().projection;
   DepthErrorAccumulator errors;
   double density_sum = 0.0, ms_sum = 0.0;
-  ReadAheadOptions read;
-  read.first = p.first();
-  read.count = p.frame_count();
-  read.step = p.step();
-  ReadAhead reader(p.sequence(), read);
+  ReadAhead reader(p.sequence(), p.read_ahead_options());
   while (auto input = reader.next()) {
     Stopwatch watch;
     source->prepare(p.sensor_frame(*input));
@@ -98,7 +93,10 @@ DepthExportResult export_depth(const Pipeline& p, const std::filesystem::path& o
     density_sum += depth_density(dense);
     const std::string name = fmt::format("{:06d}.png", input->index);
     write_depth_png(out / "depth" / name, dense);
-    cv::imwrite((out / "preview" / name).string(), colourise(dense, options.preview_max_depth));
+    const auto preview = out / "preview" / name;
+    if (!cv::imwrite(preview.string(), colourise(dense, options.preview_max_depth))) {
+      throw Error(fmt::format("{}: cannot write the preview", preview.string()));
+    }
     cv::Mat_<float> truth;
     if (!input->depth.empty() && p.depth_name() != "rgbd") {
       truth = input->depth;

@@ -6,8 +6,9 @@
 #include "rgbl/io/svg_plot.hpp"
 #include "rgbl/pipeline/pipeline.hpp"
 
+#include "json.hpp"
+
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <system_error>
@@ -16,22 +17,11 @@
 namespace rgbl {
 namespace {
 
-using Json = nlohmann::ordered_json;  // keys in the order written, for people reading the file
-
-// NaN and infinities are not JSON: null.
-Json number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+using detail::Json;
+constexpr auto number = detail::json_number;
 
 Json stage(const StageStats& s) {
   return {{"median", number(s.median)}, {"p95", number(s.p95)}, {"mean", number(s.mean)}, {"max", number(s.max)}};
-}
-
-template <typename Selected>
-Json frame_list(const RunResult& run, Selected&& selected) {
-  Json list = Json::array();
-  for (const auto& r : run.frames) {
-    if (selected(r.result)) list.push_back(r.result.frame_index);
-  }
-  return list;
 }
 
 Json closure_json(const LoopClosure& c) {
@@ -155,13 +145,13 @@ std::string summary_json(const RunResult& run) {
   j["weak"] = run.count(TrackState::Weak);
   j["lost"] = run.count(TrackState::Lost);
   j["not_initialised"] = run.count(TrackState::NotInitialised);
-  j["weak_frames"] = frame_list(run, [](const TrackResult& r) { return r.state == TrackState::Weak; });
-  j["lost_frames"] = frame_list(run, [](const TrackResult& r) { return r.state == TrackState::Lost; });
+  j["weak_frames"] = run.frames_where([](const TrackResult& r) { return r.state == TrackState::Weak; });
+  j["lost_frames"] = run.frames_where([](const TrackResult& r) { return r.state == TrackState::Lost; });
   // where tracking, lost beyond relocalisation, started a new map anchored at a guessed pose
-  j["new_map_frames"] = frame_list(run, [](const TrackResult& r) { return r.new_map; });
+  j["new_map_frames"] = run.frames_where([](const TrackResult& r) { return r.new_map; });
   // steps beyond a vehicle's reach: taken on strong evidence, or rejected (the frame placed at the prediction)
-  j["jump_frames"] = frame_list(run, [](const TrackResult& r) { return r.jump; });
-  j["rejected_step_frames"] = frame_list(run, [](const TrackResult& r) { return r.step_rejected; });
+  j["jump_frames"] = run.frames_where([](const TrackResult& r) { return r.jump; });
+  j["rejected_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_rejected; });
   j["min_inliers_ok"] = min_inliers ? Json(*min_inliers) : Json(nullptr);
   j["keyframes"] = run.keyframe_count();
   j["landmarks"] = run.landmarks.size();

@@ -3,7 +3,6 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/timer.hpp"
 #include "rgbl/depth/sources.hpp"
-#include "rgbl/io/read_ahead.hpp"
 #include "rgbl/io/settings.hpp"
 
 #include <fmt/format.h>
@@ -142,9 +141,7 @@ Pipeline::Pipeline(const PipelineOptions& options, const DepthSourceRegistry& re
   if (options_.first >= size) {
     throw ConfigError("--first", fmt::format("a frame index below {} (the sequence's length)", size));
   }
-  first_ = options_.first;
-  step_ = options_.step;
-  const std::size_t available = (size - first_ + step_ - 1) / step_;
+  const std::size_t available = (size - options_.first + options_.step - 1) / options_.step;
   count_ = options_.frames == 0 ? available : std::min(options_.frames, available);
   orb_.validate();
   system_.validate();
@@ -159,6 +156,14 @@ FeatureExtractor Pipeline::make_extractor() const {
   return [extractor](const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors) {
     extractor->extract(gray, keypoints, descriptors);
   };
+}
+
+ReadAheadOptions Pipeline::read_ahead_options() const {
+  ReadAheadOptions read;
+  read.first = options_.first;
+  read.count = count_;
+  read.step = options_.step;
+  return read;
 }
 
 SensorFrame Pipeline::sensor_frame(const FrameInput& input) const {
@@ -180,15 +185,11 @@ RunResult Pipeline::run(const Progress& progress) const {
   out.format = sequence_->format();
   out.camera = camera_;
   out.depth = depth_name_;
-  out.first = first_;
-  out.step = step_;
+  out.first = options_.first;
+  out.step = options_.step;
   out.threaded = system_.threaded_mapping;
 
-  ReadAheadOptions read_options;
-  read_options.first = first_;
-  read_options.count = count_;
-  read_options.step = step_;
-  ReadAhead frames(*sequence_, read_options);
+  ReadAhead frames(*sequence_, read_ahead_options());
   out.frames.reserve(count_);
   Stopwatch wall;
   for (;;) {
@@ -213,10 +214,12 @@ RunResult Pipeline::run(const Progress& progress) const {
   const Eigen::Isometry3d T_cam_cam0 = context_.calibration.T_cam_cam0;
   const auto& gt = sequence_->ground_truth();
   Eigen::Isometry3d T_world_first = Eigen::Isometry3d::Identity();
-  if (gt && first_ < gt->size()) T_world_first = gt->poses[first_];
+  if (gt && options_.first < gt->size()) T_world_first = gt->poses[options_.first];
+  // the tracker's world is the first tracked camera's frame
+  const Eigen::Isometry3d T_out_world = T_world_first * T_cam_cam0.inverse();
   for (const auto& pose : system.trajectory()) {
     out.trajectory.timestamps.push_back(pose.timestamp);
-    out.trajectory.poses.push_back(T_world_first * T_cam_cam0.inverse() * pose.T_world_cam * T_cam_cam0);
+    out.trajectory.poses.push_back(T_out_world * pose.T_world_cam * T_cam_cam0);
   }
   if (gt) {
     for (std::size_t i = 0; i < out.trajectory.poses.size() && frame_index(i) < gt->size(); ++i) {
@@ -235,7 +238,6 @@ RunResult Pipeline::run(const Progress& progress) const {
   // the map, in the same world frame as the trajectory
   const Map& map = system.map();
   std::shared_lock lock(map.mutex());
-  const Eigen::Isometry3d T_out_world = T_world_first * T_cam_cam0.inverse();
   for (const auto id : map.landmark_ids()) {
     if (const Landmark* l = map.landmark(id)) out.landmarks.push_back(T_out_world * l->position);
   }

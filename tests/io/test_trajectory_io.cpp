@@ -25,13 +25,6 @@ std::vector<Eigen::Isometry3d> wiggly_poses(std::size_t n) {
   return poses;
 }
 
-std::string read_all(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 template <typename F>
 void require_parse_error(F&& f, const std::filesystem::path& file, std::size_t line, const std::string& text) {
   try {
@@ -56,7 +49,7 @@ TEST_CASE("KITTI trajectory round trip is exact", "[io][trajectory]") {
   REQUIRE(back.size() == poses.size());
   for (std::size_t i = 0; i < poses.size(); ++i) CHECK(back[i].matrix() == poses[i].matrix());
   // one row-major 3x4 per line: the first line of the identity-free pose 0 is R row 0 then t.x
-  std::istringstream first_line(read_all(file));
+  std::istringstream first_line(rgbl::test::read_file(file));
   std::vector<double> v(12);
   for (auto& x : v) first_line >> x;
   CHECK(v[3] == poses[0].translation().x());

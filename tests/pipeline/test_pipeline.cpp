@@ -6,8 +6,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include <fstream>
-#include <sstream>
+#include <algorithm>
 
 using Catch::Matchers::Contains;
 
@@ -31,13 +30,6 @@ rgbl::PipelineOptions options() {
   rgbl::PipelineOptions o;
   o.dataset = curve().sequence_dir;
   return o;
-}
-
-std::string read(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 }  // namespace
@@ -84,7 +76,7 @@ TEST_CASE("a pipeline tracks a sequence, re-expresses it in the ground truth's w
   rgbl::test::TempDir out;
   rgbl::write_run_outputs(run, out.path() / "run");
   for (const auto& name : rgbl::run_output_files()) CHECK(std::filesystem::exists(out.path() / "run" / name));
-  const auto summary = nlohmann::json::parse(read(out.path() / "run" / "summary.json"));
+  const auto summary = nlohmann::json::parse(rgbl::test::read_file(out.path() / "run" / "summary.json"));
   CHECK(summary["frames"] == 18);
   CHECK(summary["first_frame"] == 4);
   CHECK(summary["step"] == 2);
@@ -94,8 +86,8 @@ TEST_CASE("a pipeline tracks a sequence, re-expresses it in the ground truth's w
   CHECK(summary["loop_closures"].is_array());
   CHECK(summary["min_inliers_ok"] == *run.min_inliers_ok());
   // 18 rows, each a 3x4 pose; row 0 is the ground truth's frame 4
-  CHECK(std::count(std::istreambuf_iterator<char>(std::ifstream(out.path() / "run" / "trajectory_kitti.txt").rdbuf()),
-                   {}, '\n') == 18);
+  const std::string rows = rgbl::test::read_file(out.path() / "run" / "trajectory_kitti.txt");
+  CHECK(std::count(rows.begin(), rows.end(), '\n') == 18);
   rgbl::remove_run_outputs(out.path() / "run");
   for (const auto& name : rgbl::run_output_files()) CHECK_FALSE(std::filesystem::exists(out.path() / "run" / name));
 }

@@ -1,38 +1,37 @@
 #pragma once
 
+#include "rgbl/core/file.hpp"
+
 #include <filesystem>
 #include <fstream>
-#include <random>
+#include <sstream>
 #include <string>
 
 namespace rgbl::test {
 
-// A fresh folder under the system temp dir, removed with its contents on destruction.
+// A fresh folder under the system temp dir, removed with its contents on destruction, with a helper
+// to put files in it.
 class TempDir {
  public:
-  TempDir() {
-    std::random_device rd;
-    path_ = std::filesystem::temp_directory_path() / ("rgbl-test-" + std::to_string(rd()) + std::to_string(rd()));
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  const std::filesystem::path& path() const { return path_; }
+  const std::filesystem::path& path() const { return folder_.path(); }
 
   std::filesystem::path write(const std::string& name, const std::string& contents) const {
-    const auto file = path_ / name;
+    const auto file = path() / name;
     std::filesystem::create_directories(file.parent_path());
     std::ofstream(file, std::ios::binary) << contents;
     return file;
   }
 
  private:
-  std::filesystem::path path_;
+  TemporaryFolder folder_{"rgbl-test"};
 };
+
+// The whole file as a string (empty when it cannot be read).
+inline std::string read_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
 
 }  // namespace rgbl::test

@@ -53,8 +53,8 @@ struct PointTraits {
 };
 
 // Any range of points (PCL clouds, ROS messages converted, your own structs) as the LidarPoints the
-// kernels take, reusing `out`'s capacity. A scan of 120k points copies in well under a millisecond,
-// and the kernels stay compiled once, with their per-CPU clones.
+// kernels take, reusing `out`'s capacity: one copy, so that the kernels stay compiled once, with their
+// per-CPU clones.
 template <typename Range>
 void to_lidar_points(const Range& cloud, std::vector<LidarPoint>& out) {
   using Point = std::remove_cvref_t<decltype(*std::begin(cloud))>;

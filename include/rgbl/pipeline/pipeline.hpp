@@ -11,6 +11,7 @@
 #include "rgbl/depth/sources.hpp"
 #include "rgbl/eval/trajectory_metrics.hpp"
 #include "rgbl/features/orb.hpp"
+#include "rgbl/io/read_ahead.hpp"
 #include "rgbl/io/sequence.hpp"
 #include "rgbl/io/trajectory_io.hpp"
 #include "rgbl/tracking/system.hpp"
@@ -97,6 +98,15 @@ struct RunResult {
   std::size_t keyframe_count() const;
   std::optional<int> min_inliers_ok() const;  // fewest local-map inliers on a frame reported ok
   RunTimings timings() const;
+  // Dataset indices of the frames whose TrackResult satisfies `selected`, e.g. [](auto& r) { return r.jump; }.
+  template <typename Selected>
+  std::vector<std::size_t> frames_where(Selected&& selected) const {
+    std::vector<std::size_t> indices;
+    for (const auto& r : frames) {
+      if (selected(r.result)) indices.push_back(r.result.frame_index);
+    }
+    return indices;
+  }
 };
 
 // A dataset opened and every option resolved and validated: construction fails early, naming the
@@ -116,10 +126,10 @@ class Pipeline {
   const LidarSourceOptions& lidar_options() const { return lidar_; }  // the settings file's (defaults without one)
   const SystemOptions& system_options() const { return system_; }
   const OrbOptions& orb_options() const { return orb_; }
-  std::size_t first() const { return first_; }
-  std::size_t step() const { return step_; }
   std::size_t frame_count() const { return count_; }   // frames run() tracks
-  std::size_t frame_index(std::size_t i) const { return first_ + i * step_; }
+  std::size_t frame_index(std::size_t i) const { return options_.first + i * options_.step; }
+  // The frames run() tracks, loaded ahead on a second thread.
+  ReadAheadOptions read_ahead_options() const;
   // Decisions taken on the user's behalf (e.g. "LiDAR.Tr overrides the dataset's extrinsics"), to show once.
   const std::vector<std::string>& notes() const { return notes_; }
 
@@ -144,7 +154,7 @@ class Pipeline {
   LidarSourceOptions lidar_;
   SystemOptions system_;
   OrbOptions orb_;
-  std::size_t first_ = 0, count_ = 0, step_ = 1;
+  std::size_t count_ = 0;
   std::vector<std::string> notes_;
 };
 
