@@ -61,54 +61,80 @@ void discard_outliers(Frame& frame) {
   }
 }
 
+int count_tracked(const Frame& frame) {
+  return static_cast<int>(std::count_if(frame.landmarks.begin(), frame.landmarks.end(), [](LandmarkId l) { return l.valid(); }));
+}
+
 }  // namespace
 
+// Hypotheses are built as values by const members (first, maybe relocalisation, maybe the step
+// check's), the chosen one is committed once: nothing but commit() and initialisation changes state.
 TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   TrackerOutcome outcome;
-  const TrackState previous_state = state_;
   frame.landmarks.assign(frame.size(), LandmarkId{});
   frame.outlier.assign(frame.size(), false);
   frame.moving.clear();
-  auto count_tracked = [](const Frame& f) {
-    return static_cast<int>(std::count_if(f.landmarks.begin(), f.landmarks.end(), [](LandmarkId l) { return l.valid(); }));
-  };
-  auto finish_initialised = [&] {
-    state_ = TrackState::Ok;
-    outcome.initialised_now = true;
-    outcome.inliers = count_tracked(frame);
-    last_ok_frame_ = frame.index;
-    last_inliers_ = 0;  // every depth point is a landmark here: no yardstick for the next frame
-    outcome.state = state_;
-    last_frame_ = frame;
-    last_frame_->grid = FeatureGrid();
-    last_tracked_frame_.reset();
-    return outcome;
-  };
   if (state_ == TrackState::NotInitialised) {
-    if (initialise(frame, Eigen::Isometry3d::Identity())) return finish_initialised();
+    if (initialise(frame, Eigen::Isometry3d::Identity())) return finish_initialised(frame, outcome);
     outcome.state = state_;
     last_frame_ = frame;
     last_frame_->grid = FeatureGrid();
     return outcome;
   }
+  const Prediction prediction = predict(frame);
+  ViewLog views;
+  FirstHypothesis first = first_hypothesis(std::move(frame), prediction, views);
+  Hypothesis h = std::move(first.hypothesis);
+  if ((first.suspect || !h.ok) && !first.relocalisation_tried) {
+    // A second hypothesis from the whole map, independent of any prediction, for a suspect pose and
+    // before declaring the camera lost; taken when it explains more of the frame.
+    Hypothesis relocalised = relocalisation_hypothesis(h.frame, h.reference, views);
+    if (relocalised.ok && relocalised.inliers > h.inliers) {
+      h = std::move(relocalised);
+    } else if (!relocalised.ok && first.suspect) {
+      h.ok = false;
+    }
+    if (first.suspect) {
+      logger()->debug("frame {}: motion model suspect ({} inliers, last frame {}; local map {}/{}): {}",
+                      h.frame.index, first.motion_inliers, last_inliers_, first.local.inliers, first.local.visible,
+                      h.relocalised ? "relocalised" : (h.ok ? "confirmed" : "lost"));
+    }
+  }
+  if (h.ok && options_.check_steps && velocity_steady_ && has_pose(state_) && last_frame_ && !h.relocalised) {
+    h = step_hypothesis(std::move(h), prediction, views);
+  }
+  commit(h, prediction, first, views, mapping_idle, outcome);
+  frame = std::move(h.frame);
+  if (outcome.new_map) return finish_initialised(frame, outcome);
+  last_frame_ = frame;
+  last_frame_->grid = FeatureGrid();
+  return outcome;
+}
 
-  const Eigen::Isometry3d T_last = last_frame_ ? last_frame_->T_cam_world : Eigen::Isometry3d::Identity();
-  // Best guess for a lost frame: constant velocity over the time elapsed since the last frame, so
-  // that dropped frames (a gap in the timestamps) move the guess as far as the camera went.
-  Eigen::Isometry3d T_predicted = velocity_ ? *velocity_ * T_last : T_last;
+Tracker::Prediction Tracker::predict(const Frame& frame) const {
+  Prediction p;
+  if (last_frame_) p.T_last_world = last_frame_->T_cam_world;
+  p.T_cam_world = velocity_ ? *velocity_ * p.T_last_world : p.T_last_world;
+  // Constant velocity over the time elapsed since the last frame, so that dropped frames (a gap in
+  // the timestamps) move the guess as far as the camera went.
   if (velocity_ && last_frame_ && velocity_dt_ > 0.0) {
     const double steps = (frame.timestamp - last_frame_->timestamp) / velocity_dt_;
-    if (std::isfinite(steps) && steps > 0.0) T_predicted = se3_exp(steps * se3_log(*velocity_)) * T_last;
+    if (std::isfinite(steps) && steps > 0.0) p.T_cam_world = se3_exp(steps * se3_log(*velocity_)) * p.T_last_world;
   }
+  return p;
+}
+
+Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction& prediction, ViewLog& views) const {
+  FirstHypothesis first;
+  Hypothesis& h = first.hypothesis;
+  h.reference = reference_;
+  h.relocalisation_frame = last_relocalisation_frame_;
   bool ok = false;
-  bool motion_ok = false;
-  int motion_inliers = 0;
-  bool recent_loss = false;
   if (has_pose(state_)) {
     if (velocity_ && last_frame_) {
-      motion_inliers =
+      first.motion_inliers =
           track_with_motion_model(frame, *last_frame_, *velocity_ * last_frame_->T_cam_world, trusted_velocity());
-      ok = motion_ok = motion_inliers >= options_.min_pose_inliers;
+      ok = first.motion_ok = first.motion_inliers >= options_.min_pose_inliers;
     }
     if (!ok) {
       clear_matches(frame);
@@ -117,139 +143,148 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   } else {
     // Recently lost: the frame-to-frame motion (depth RANSAC + temporary points) usually still holds
     // and keeps the trajectory continuous; otherwise relocalise against the whole map.
-    recent_loss = velocity_ && last_frame_ && frame.index <= last_ok_frame_ + options_.recent_loss_frames;
-    if (recent_loss) {
+    first.recent_loss = velocity_ && last_frame_ && frame.index <= last_ok_frame_ + options_.recent_loss_frames;
+    if (first.recent_loss) {
       // Against the last tracked frame (the frames since carry only guesses and maybe no features,
       // e.g. black images), from the guess over the time elapsed.
       const Frame& reference = last_tracked_frame_ ? *last_tracked_frame_ : *last_frame_;
-      motion_inliers = track_with_motion_model(frame, reference, T_predicted, std::nullopt);
-      ok = motion_ok = motion_inliers >= options_.min_pose_inliers;
+      first.motion_inliers = track_with_motion_model(frame, reference, prediction.T_cam_world, std::nullopt);
+      ok = first.motion_ok = first.motion_inliers >= options_.min_pose_inliers;
       if (!ok) clear_matches(frame);
     }
     if (!ok) {
-      ok = relocalise(frame);
-      outcome.relocalised = ok;
+      ok = h.relocalised = relocalise(frame);
+      // counts even if the local map rejects it below: the next frames need the stricter support
+      if (ok) h.relocalisation_frame = frame.index;
     }
   }
-  const bool relocalisation_tried = state_ == TrackState::Lost && !motion_ok;
-  int inliers = 0;
-  bool weak = false;
-  bool is_suspect = false;
-  LocalMapResult local;
+  first.relocalisation_tried = state_ == TrackState::Lost && !first.motion_ok;
   if (ok) {
-    const Frame after_motion = motion_ok ? frame : Frame{};
-    local = track_local_map(frame);
-    ok = local.ok;
-    if (ok && outcome.relocalised && !relocalisation_confirmed(local)) {
+    const Frame after_motion = first.motion_ok ? frame : Frame{};
+    first.local = track_local_map(frame, h.reference, h.relocalisation_frame, views);
+    h.reference = first.local.reference;
+    ok = first.local.ok;
+    if (ok && h.relocalised && !relocalisation_confirmed(first.local)) {
       logger()->debug("frame {}: relocalisation rejected, the local map re-finds {} of {} points", frame.index,
-                      local.inliers, local.visible);
-      ok = false;
-      outcome.relocalised = false;
+                      first.local.inliers, first.local.visible);
+      ok = h.relocalised = false;
     }
-    is_suspect = motion_ok && suspect(motion_inliers, local);
-    if (!ok && motion_ok && options_.keep_weak_tracking && !is_suspect) {
+    first.suspect = first.motion_ok && suspect(first.motion_inliers, first.local);
+    if (!ok && first.motion_ok && options_.keep_weak_tracking && !first.suspect) {
       // The map is thin here (e.g. mapping lags behind) but frame-to-frame motion held: keep the
       // motion-model pose and refresh the map with a keyframe instead of declaring the camera lost.
       frame = after_motion;
       frame.build_grid(camera_.width, camera_.height);
-      ok = true;
-      weak = true;
+      ok = h.weak = true;
     }
-    inliers = ok ? count_tracked(frame) : 0;
+    h.inliers = ok ? count_tracked(frame) : 0;
   }
-  if ((is_suspect || !ok) && !relocalisation_tried) {
-    // A second hypothesis from the whole map, independent of any prediction, for a suspect pose and
-    // before declaring the camera lost. Its side effects on the local map are undone if not taken.
-    const KeyframeId reference = reference_;
-    const std::vector<KeyframeId> local_keyframes = local_keyframes_;
-    const std::vector<LandmarkId> local_landmarks = local_landmarks_;
-    const std::size_t last_relocalisation = last_relocalisation_frame_;
-    Frame candidate = frame;  // tracking changed only its pose and matches
-    clear_matches(candidate);
-    const bool relocalised_pnp = relocalise(candidate);
-    const LocalMapResult candidate_local = relocalised_pnp ? track_local_map(candidate) : LocalMapResult{};
-    const bool relocalised = relocalised_pnp && candidate_local.ok && relocalisation_confirmed(candidate_local);
-    const int candidate_inliers = relocalised ? count_tracked(candidate) : 0;
-    if (relocalised && candidate_inliers > inliers) {
-      frame = std::move(candidate);
-      inliers = candidate_inliers;
-      ok = true;
-      weak = false;
-      outcome.relocalised = true;
-    } else {
-      reference_ = reference;
-      local_keyframes_ = local_keyframes;
-      local_landmarks_ = local_landmarks;
-      last_relocalisation_frame_ = last_relocalisation;
-      if (!relocalised && is_suspect) ok = false;
+  h.ok = ok;
+  h.frame = std::move(frame);
+  return first;
+}
+
+Tracker::Hypothesis Tracker::relocalisation_hypothesis(Frame frame, KeyframeId reference, ViewLog& views) const {
+  Hypothesis h;
+  h.reference = reference;
+  h.relocalisation_frame = frame.index;
+  clear_matches(frame);
+  if (relocalise(frame)) {
+    const LocalMapResult local = track_local_map(frame, reference, frame.index, views);
+    h.reference = local.reference;
+    h.ok = h.relocalised = local.ok && relocalisation_confirmed(local);
+    h.inliers = h.ok ? count_tracked(frame) : 0;
+  }
+  h.frame = std::move(frame);
+  return h;
+}
+
+Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const {
+  // Never take silently a step that a vehicle cannot make: only on the evidence a relocalisation
+  // needs (then reported), else try the local map from the prediction, else keep the prediction.
+  const double dt = h.frame.timestamp - last_frame_->timestamp;
+  const double predicted_step =
+      (prediction.T_cam_world.inverse().translation() - prediction.T_last_world.inverse().translation()).norm();
+  const StepCheck step = check_step(h.frame.T_cam_world, prediction.T_cam_world, predicted_step, dt, options_);
+  if (step.plausible) return h;
+  if (h.inliers >= options_.min_jump_inliers && !h.weak) {
+    h.jump = true;
+    logger()->warn("frame {}: step {:.2f} m / {:.1f} deg off the constant-velocity prediction (allowed {:.2f} m), "
+                   "taken on {} inliers", h.frame.index, step.translation_m, step.rotation_deg,
+                   step.allowed_translation_m, h.inliers);
+    return h;
+  }
+  Frame candidate = h.frame;
+  candidate.T_cam_world = prediction.T_cam_world;
+  clear_matches(candidate);
+  const LocalMapResult from_prediction = track_local_map(candidate, h.reference, h.relocalisation_frame, views);
+  const StepCheck candidate_step =
+      check_step(candidate.T_cam_world, prediction.T_cam_world, predicted_step, dt, options_);
+  logger()->debug("frame {}: step {:.2f} m / {:.1f} deg off the prediction (allowed {:.2f} m) on {} inliers; "
+                  "from the prediction the local map finds {} ({:.2f} m off)", h.frame.index, step.translation_m,
+                  step.rotation_deg, step.allowed_translation_m, h.inliers, from_prediction.inliers,
+                  candidate_step.translation_m);
+  // either way the frame is at (or near) the prediction: the local map searched there is its own
+  h.reference = from_prediction.reference;
+  if (from_prediction.ok && candidate_step.plausible) {
+    h.frame = std::move(candidate);
+    h.inliers = count_tracked(h.frame);
+    h.weak = false;
+  } else {
+    h.frame.T_cam_world = prediction.T_cam_world;
+    clear_matches(h.frame);
+    h.inliers = 0;
+    h.weak = h.step_rejected = true;
+  }
+  return h;
+}
+
+void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHypothesis& first, const ViewLog& views,
+                     bool mapping_idle, TrackerOutcome& outcome) {
+  {
+    std::unique_lock lock(map_.mutex());
+    for (const LandmarkId id : views.visible) {
+      if (Landmark* l = map_.landmark(id)) ++l->visible;
     }
-    if (is_suspect) {
-      logger()->debug("frame {}: motion model suspect ({} inliers, last frame {}; local map {}/{}): {}",
-                      frame.index, motion_inliers, last_inliers_, local.inliers, local.visible,
-                      outcome.relocalised ? "relocalised" : (ok ? "confirmed" : "lost"));
+    for (const LandmarkId id : views.found) {
+      if (Landmark* l = map_.landmark(id)) ++l->found;
     }
   }
-  if (ok && options_.check_steps && velocity_steady_ && has_pose(state_) && last_frame_ && !outcome.relocalised) {
-    // Never take silently a step that a vehicle cannot make: only on the evidence a relocalisation
-    // needs (then reported), else try the local map from the prediction, else keep the prediction.
-    const double dt = frame.timestamp - last_frame_->timestamp;
-    const double predicted_step = (T_predicted.inverse().translation() - T_last.inverse().translation()).norm();
-    const StepCheck step = check_step(frame.T_cam_world, T_predicted, predicted_step, dt, options_);
-    if (!step.plausible && inliers >= options_.min_jump_inliers && !weak) {
-      outcome.jump = true;
-      logger()->warn("frame {}: step {:.2f} m / {:.1f} deg off the constant-velocity prediction (allowed {:.2f} m), "
-                     "taken on {} inliers", frame.index, step.translation_m, step.rotation_deg,
-                     step.allowed_translation_m, inliers);
-    } else if (!step.plausible) {
-      Frame candidate = frame;
-      candidate.T_cam_world = T_predicted;
-      clear_matches(candidate);
-      const LocalMapResult from_prediction = track_local_map(candidate);
-      const StepCheck candidate_step = check_step(candidate.T_cam_world, T_predicted, predicted_step, dt, options_);
-      logger()->debug("frame {}: step {:.2f} m / {:.1f} deg off the prediction (allowed {:.2f} m) on {} inliers; "
-                      "from the prediction the local map finds {} ({:.2f} m off)", frame.index, step.translation_m,
-                      step.rotation_deg, step.allowed_translation_m, inliers, from_prediction.inliers,
-                      candidate_step.translation_m);
-      if (from_prediction.ok && candidate_step.plausible) {
-        frame = std::move(candidate);
-        inliers = count_tracked(frame);
-        weak = false;
-      } else {
-        frame.T_cam_world = T_predicted;
-        clear_matches(frame);
-        inliers = 0;
-        weak = true;
-        outcome.step_rejected = true;
-      }
-    }
-  }
-  if (ok) {
+  const TrackState previous_state = state_;
+  Frame& frame = h.frame;
+  reference_ = h.reference;
+  last_relocalisation_frame_ = h.relocalisation_frame;
+  outcome.relocalised = h.relocalised;
+  outcome.jump = h.jump;
+  outcome.step_rejected = h.step_rejected;
+  int inliers = h.inliers;
+  if (h.ok) {
     const bool consecutive = has_pose(state_);  // the previous frame was tracked too
-    state_ = weak ? TrackState::Weak : support_state(inliers, frames_since_relocalisation(frame), options_);
+    state_ = h.weak ? TrackState::Weak : support_state(inliers, frames_since_relocalisation(frame), options_);
     last_ok_frame_ = frame.index;
     last_inliers_ = inliers;
-    if (last_frame_ && !outcome.step_rejected) {
+    if (last_frame_ && !h.step_rejected) {
       velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
       velocity_dt_ = frame.timestamp - last_frame_->timestamp;
-      velocity_steady_ = consecutive && motion_ok && !outcome.relocalised;
+      velocity_steady_ = consecutive && first.motion_ok && !h.relocalised;
     }
     // a frame placed at the prediction has no observations worth a keyframe
-    outcome.need_keyframe = !outcome.step_rejected && (weak || need_keyframe(frame, inliers, mapping_idle));
+    outcome.need_keyframe = !h.step_rejected && (h.weak || need_keyframe(frame, inliers, mapping_idle));
   } else {
     const bool was_lost = state_ == TrackState::Lost;
     state_ = TrackState::Lost;
     velocity_steady_ = false;
     inliers = 0;
     last_inliers_ = 0;
-    frame.T_cam_world = T_predicted;  // best guess, reported with state Lost
+    frame.T_cam_world = prediction.T_cam_world;  // best guess, reported with state Lost
     clear_matches(frame);
     // Lost beyond the recent-loss window and the map does not know this place: carry on in a new map
     // anchored at the guess (as ORB-SLAM3's atlas) rather than staying lost until the camera returns.
-    if (was_lost && !recent_loss && options_.new_map_when_lost && initialise(frame, T_predicted)) {
+    if (was_lost && !first.recent_loss && options_.new_map_when_lost && initialise(frame, prediction.T_cam_world)) {
       logger()->warn("frame {}: lost since frame {} and relocalisation failed: new map started at the "
                      "constant-velocity guess", frame.index, last_ok_frame_);
       outcome.new_map = true;
-      return finish_initialised();
+      return;
     }
   }
   outcome.state = state_;
@@ -259,8 +294,18 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   } else if (has_pose(previous_state) && last_frame_) {
     last_tracked_frame_ = std::move(last_frame_);  // the first lost frame: keep the last tracked one
   }
+}
+
+TrackerOutcome& Tracker::finish_initialised(const Frame& frame, TrackerOutcome& outcome) {
+  state_ = TrackState::Ok;
+  outcome.initialised_now = true;
+  outcome.inliers = count_tracked(frame);
+  last_ok_frame_ = frame.index;
+  last_inliers_ = 0;  // every depth point is a landmark here: no yardstick for the next frame
+  outcome.state = state_;
   last_frame_ = frame;
   last_frame_->grid = FeatureGrid();
+  last_tracked_frame_.reset();
   return outcome;
 }
 
@@ -300,11 +345,10 @@ bool Tracker::initialise(Frame& frame, const Eigen::Isometry3d& T_cam_world) {
   }
   reference_ = id;
   last_keyframe_frame_ = frame.index;
-  local_keyframes_ = {id};
   return true;
 }
 
-int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra) {
+int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra) const {
   std::vector<PoseObservation> observations;
   std::vector<std::size_t> keypoint_of;
   observations.reserve(frame.size());
@@ -341,7 +385,7 @@ int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t
 }
 
 int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const Eigen::Isometry3d& T_guess,
-                                     const std::optional<Eigen::Isometry3d>& prior) {
+                                     const std::optional<Eigen::Isometry3d>& prior) const {
   frame.T_cam_world = T_guess;
   bool from_consensus = false;
   if (options_.ransac_prediction) {
@@ -421,7 +465,7 @@ int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const
   return inliers;
 }
 
-bool Tracker::track_reference_keyframe(Frame& frame) {
+bool Tracker::track_reference_keyframe(Frame& frame) const {
   std::vector<Descriptor> train;
   std::vector<LandmarkId> train_landmarks;
   {
@@ -482,7 +526,8 @@ void Tracker::drop_moving_matches(Frame& frame, double slack) const {
   }
 }
 
-void Tracker::update_local_map(const Frame& frame) {
+std::pair<std::vector<KeyframeId>, KeyframeId> Tracker::local_map_around(const Frame& frame,
+                                                                         KeyframeId reference) const {
   std::map<KeyframeId, int> votes;
   for (std::size_t i = 0; i < frame.size(); ++i) {
     const Landmark* l = frame.landmarks[i].valid() ? map_.landmark(frame.landmarks[i]) : nullptr;
@@ -493,36 +538,36 @@ void Tracker::update_local_map(const Frame& frame) {
   for (const auto& [kf, n] : votes) sorted.emplace_back(n, kf);
   std::sort(sorted.begin(), sorted.end(),
             [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second > b.second; });
-  local_keyframes_.clear();
-  std::vector<KeyframeId> added;
+  std::vector<KeyframeId> keyframes;
   auto push = [&](KeyframeId id) {
-    if (std::find(local_keyframes_.begin(), local_keyframes_.end(), id) != local_keyframes_.end()) return;
-    local_keyframes_.push_back(id);
+    if (std::find(keyframes.begin(), keyframes.end(), id) != keyframes.end()) return;
+    keyframes.push_back(id);
   };
   for (const auto& [n, kf] : sorted) {
-    if (static_cast<int>(local_keyframes_.size()) >= options_.max_local_keyframes) break;
+    if (static_cast<int>(keyframes.size()) >= options_.max_local_keyframes) break;
     push(kf);
   }
   // Nothing matched yet (the frame was tracked on temporary points only, e.g. after a loss): search
   // around the reference keyframe rather than in an empty local map.
-  if (local_keyframes_.empty() && map_.keyframe(reference_) != nullptr) push(reference_);
-  const std::size_t direct = local_keyframes_.size();
-  for (std::size_t i = 0; i < direct && static_cast<int>(local_keyframes_.size()) < options_.max_local_keyframes; ++i) {
-    for (const KeyframeId n : map_.best_covisible(local_keyframes_[i], 10)) {
-      if (static_cast<int>(local_keyframes_.size()) >= options_.max_local_keyframes) break;
+  if (keyframes.empty() && map_.keyframe(reference) != nullptr) push(reference);
+  const std::size_t direct = keyframes.size();
+  for (std::size_t i = 0; i < direct && static_cast<int>(keyframes.size()) < options_.max_local_keyframes; ++i) {
+    for (const KeyframeId n : map_.best_covisible(keyframes[i], 10)) {
+      if (static_cast<int>(keyframes.size()) >= options_.max_local_keyframes) break;
       push(n);
     }
   }
-  if (!sorted.empty()) reference_ = sorted.front().second;
-  local_landmarks_ = map_.landmarks_seen_by(local_keyframes_);
+  return {std::move(keyframes), sorted.empty() ? reference : sorted.front().second};
 }
 
-Tracker::LocalMapResult Tracker::track_local_map(Frame& frame) {
+Tracker::LocalMapResult Tracker::track_local_map(Frame& frame, KeyframeId reference, std::size_t relocalisation_frame,
+                                                 ViewLog& views) const {
+  LocalMapResult result;
   std::vector<detail::ProjectedLandmark> candidates;
-  std::vector<LandmarkId> visible;
   {
     std::shared_lock lock(map_.mutex());
-    update_local_map(frame);
+    auto [keyframes, new_reference] = local_map_around(frame, reference);
+    result.reference = new_reference;
     std::vector<LandmarkId> matched;
     for (const LandmarkId l : frame.landmarks) {
       if (l.valid()) matched.push_back(l);
@@ -531,13 +576,14 @@ Tracker::LocalMapResult Tracker::track_local_map(Frame& frame) {
     const Eigen::Isometry3d T_world_cam = frame.T_cam_world.inverse();
     const Eigen::Vector3d center = T_world_cam.translation();
     const MapOptions& map_options = map_.options();
-    for (const LandmarkId id : local_landmarks_) {
+    for (const LandmarkId id : map_.landmarks_seen_by(keyframes)) {
       if (std::binary_search(matched.begin(), matched.end(), id)) continue;
       const Landmark* l = map_.landmark(id);
       if (l == nullptr) continue;
       const auto view = view_landmark(*l, frame.T_cam_world, center, camera_, map_options, options_.min_view_cos);
       if (!view) continue;
-      visible.push_back(id);
+      ++result.visible;
+      views.visible.push_back(id);
       detail::ProjectedLandmark c;
       c.id = id;
       c.descriptor = l->descriptor;
@@ -553,27 +599,16 @@ Tracker::LocalMapResult Tracker::track_local_map(Frame& frame) {
                                  static_cast<float>(options_.depth_gate_min_local_map)};
     detail::match_projected(frame, candidates, options_.max_hamming, options_.local_map_ratio, false, nullptr, gate);
   }
-  const int inliers = optimise_pose(frame);
-  {
-    std::unique_lock lock(map_.mutex());
-    for (const LandmarkId id : visible) {
-      if (Landmark* l = map_.landmark(id)) ++l->visible;
-    }
-    for (std::size_t i = 0; i < frame.size(); ++i) {
-      if (!frame.landmarks[i].valid()) continue;
-      if (frame.outlier[i]) continue;
-      if (Landmark* l = map_.landmark(frame.landmarks[i])) ++l->found;
-    }
+  result.inliers = optimise_pose(frame);
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.landmarks[i].valid() && !frame.outlier[i]) views.found.push_back(frame.landmarks[i]);
   }
   discard_outliers(frame);
-  LocalMapResult result;
-  result.inliers = inliers;
-  result.visible = static_cast<int>(visible.size());
-  result.ok = support_state(inliers, frames_since_relocalisation(frame), options_) == TrackState::Ok;
+  result.ok = support_state(result.inliers, frames_since(frame, relocalisation_frame), options_) == TrackState::Ok;
   return result;
 }
 
-bool Tracker::relocalise(Frame& frame) {
+bool Tracker::relocalise(Frame& frame) const {
   std::vector<Descriptor> train;
   std::vector<LandmarkId> ids;
   std::vector<Eigen::Vector3d> positions;
@@ -623,9 +658,7 @@ bool Tracker::relocalise(Frame& frame) {
   }
   const int inliers = optimise_pose(frame);
   discard_outliers(frame);
-  if (inliers < options_.min_pose_inliers) return false;
-  last_relocalisation_frame_ = frame.index;
-  return true;
+  return inliers >= options_.min_pose_inliers;
 }
 
 bool Tracker::need_keyframe(const Frame& frame, int inliers, bool mapping_idle) const {

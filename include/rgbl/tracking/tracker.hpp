@@ -4,6 +4,10 @@
 // suspect motion-model pose is checked by relocalisation, and a camera lost where the map cannot place
 // it starts a new map. The tracker also decides when a frame becomes a keyframe. It never throws on bad
 // input: failure is a state.
+//
+// Each way of placing a frame is a Hypothesis built as a value by const members; track() chooses one
+// and commit() makes it the tracker's state, once. The local-map searches of every hypothesis tried
+// count towards the landmarks' visible/found ratios (committed with the frame).
 
 #include "rgbl/geometry/camera.hpp"
 #include "rgbl/map/map.hpp"
@@ -12,6 +16,8 @@
 #include "rgbl/tracking/support.hpp"
 
 #include <optional>
+#include <utility>
+#include <vector>
 
 namespace rgbl {
 
@@ -49,43 +55,97 @@ class Tracker {
   const std::optional<Eigen::Isometry3d>& velocity() const { return velocity_; }
 
  private:
+  // What a local-map search around a frame's pose found.
   struct LocalMapResult {
     bool ok = false;
     int inliers = 0;
-    int visible = 0;  // local-map points predicted in view (searched for)
+    int visible = 0;       // local-map points predicted in view (searched for)
+    KeyframeId reference;  // the keyframe sharing most points with the frame (else the one searched around)
+  };
+  // The landmarks the local-map searches of one frame predicted in view and matched. Their visible and
+  // found counts (which decide culling) are committed with the frame, for every search it made.
+  struct ViewLog {
+    std::vector<LandmarkId> visible, found;
+  };
+  // One placement of the frame and the tracker state that comes with it if it is chosen.
+  struct Hypothesis {
+    Frame frame;
+    bool ok = false;
+    bool weak = false;         // kept on frame-to-frame motion alone, or placed at the prediction
+    bool relocalised = false;  // placed against the whole map
+    bool jump = false;           // a step beyond a vehicle's reach, taken on strong evidence
+    bool step_rejected = false;  // ...on weak evidence: placed at the prediction
+    int inliers = 0;
+    KeyframeId reference;                   // the reference keyframe it leaves
+    std::size_t relocalisation_frame = 0;   // the last relocalisation, this frame's if it made one
+  };
+  // The first hypothesis (motion model, reference keyframe, or relocalisation when lost) and the
+  // evidence that decides whether a second one is needed.
+  struct FirstHypothesis {
+    Hypothesis hypothesis;
+    bool motion_ok = false;  // frame-to-frame motion found enough inliers
+    int motion_inliers = 0;
+    bool recent_loss = false;
+    bool relocalisation_tried = false;
+    bool suspect = false;    // motion-model pose disagreeing with the map or the recent frames
+    LocalMapResult local;
+  };
+  // Constant-velocity prediction of the frame's pose.
+  struct Prediction {
+    Eigen::Isometry3d T_last_world = Eigen::Isometry3d::Identity();  // the last frame's pose
+    Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();   // over the time elapsed since
   };
 
+  Prediction predict(const Frame& frame) const;
+  FirstHypothesis first_hypothesis(Frame frame, const Prediction& prediction, ViewLog& views) const;
+  // Relocalisation against the whole map, independent of any prediction, confirmed on the local map.
+  Hypothesis relocalisation_hypothesis(Frame frame, KeyframeId reference, ViewLog& views) const;
+  // A step beyond a vehicle's reach on weak evidence: the local map searched from the prediction
+  // instead, else the frame placed at the prediction.
+  Hypothesis step_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const;
+  // Makes the chosen hypothesis the tracker's state (the only place track() changes it).
+  void commit(Hypothesis& h, const Prediction& prediction, const FirstHypothesis& first, const ViewLog& views,
+              bool mapping_idle, TrackerOutcome& outcome);
+
   bool initialise(Frame& frame, const Eigen::Isometry3d& T_cam_world);
+  // The frame started a map (the first, or a new one when lost): it is the last frame and tracked.
+  TrackerOutcome& finish_initialised(const Frame& frame, TrackerOutcome& outcome);
   // Returns the pose inliers (landmarks and temporary points), 0 when matching failed.
   // Guided matching against `reference` (the last frame, or after a loss the last tracked one) from
   // T_guess, refined by the frame-to-frame motion from depth (constrained to `prior` if given).
   int track_with_motion_model(Frame& frame, const Frame& reference, const Eigen::Isometry3d& T_guess,
-                              const std::optional<Eigen::Isometry3d>& prior);
+                              const std::optional<Eigen::Isometry3d>& prior) const;
   // The velocity as a motion prior: only while it comes from two consecutive tracked frames.
   std::optional<Eigen::Isometry3d> trusted_velocity() const {
     return options_.ransac_motion_prior && velocity_steady_ ? velocity_ : std::nullopt;
   }
-  bool track_reference_keyframe(Frame& frame);
+  bool track_reference_keyframe(Frame& frame) const;
   // Unmatches keypoints labelled moving and those whose landmark disagrees with frame.T_cam_world (a
   // depth-consensus prediction; see disagrees_with_pose).
   void drop_moving_matches(Frame& frame, double slack = 0.0) const;
   // Keypoint i against world point p_world seen from frame.T_cam_world: in 3-D where it has depth
   // (beyond slack metres more than the gate), else beyond the guided-matching radius in the image.
   bool disagrees_with_pose(const Frame& frame, std::size_t i, const Eigen::Vector3d& p_world, double slack = 0.0) const;
-  LocalMapResult track_local_map(Frame& frame);
+  // Searches the local map around `reference` (see local_map_around) from the frame's pose.
+  LocalMapResult track_local_map(Frame& frame, KeyframeId reference, std::size_t relocalisation_frame,
+                                 ViewLog& views) const;
+  // The keyframes sharing points with the frame and their neighbours; the caller holds the map lock.
+  std::pair<std::vector<KeyframeId>, KeyframeId> local_map_around(const Frame& frame, KeyframeId reference) const;
   // The motion-model hypothesis disagrees with the map or with the recent frames (see TrackerOptions).
   bool suspect(int motion_inliers, const LocalMapResult& local) const;
-  bool relocalise(Frame& frame);
+  bool relocalise(Frame& frame) const;
   // The local-map search from a relocalised pose re-finds enough of the points it predicts visible.
   bool relocalisation_confirmed(const LocalMapResult& local) const;
   // extra: (keypoint, world point) correspondences that are not landmarks (temporary points).
-  int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {});
+  int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {}) const;
   bool need_keyframe(const Frame& frame, int inliers, bool mapping_idle) const;
   std::optional<std::size_t> frames_since_relocalisation(const Frame& frame) const {
-    if (last_relocalisation_frame_ == 0 || frame.index < last_relocalisation_frame_) return std::nullopt;
-    return frame.index - last_relocalisation_frame_;
+    return frames_since(frame, last_relocalisation_frame_);
   }
-  void update_local_map(const Frame& frame);
+  static std::optional<std::size_t> frames_since(const Frame& frame, std::size_t relocalisation_frame) {
+    if (relocalisation_frame == 0 || frame.index < relocalisation_frame) return std::nullopt;
+    return frame.index - relocalisation_frame;
+  }
 
   Map& map_;
   PinholeCamera camera_;
@@ -101,8 +161,6 @@ class Tracker {
   std::optional<Eigen::Isometry3d> velocity_;  // T_cur_last
   double velocity_dt_ = 0.0;  // timestamp difference of that pair (0 = unknown)
   bool velocity_steady_ = false;  // velocity_ comes from two consecutive tracked frames (no relocalisation)
-  std::vector<KeyframeId> local_keyframes_;
-  std::vector<LandmarkId> local_landmarks_;
 };
 
 }  // namespace rgbl
