@@ -1,5 +1,6 @@
 #include "input_options.hpp"
 
+#include "rgbl/core/error.hpp"
 #include "rgbl/core/timer.hpp"
 
 #include <fmt/format.h>
@@ -11,7 +12,7 @@
 namespace rgbl::cli {
 namespace {
 
-void print_summary(const RunResult& run, const std::filesystem::path& out_dir) {
+void print_summary(const RunResult& run, const std::filesystem::path& out_dir, bool failed) {
   const RunTimings t = run.timings();
   fmt::print("\n{} ({}), camera {}, depth {}: {} frames in {:.1f} s\n", run.sequence_name, to_string(run.format),
              run.camera, run.depth, run.frames.size(), run.wall_s);
@@ -41,16 +42,23 @@ void print_summary(const RunResult& run, const std::filesystem::path& out_dir) {
   fmt::print("  depth+extraction+tracking {:.2f} ms median; total {:.2f} ms median, {:.2f} ms mean\n", t.front.median,
              t.total.median, t.total.mean);
   if (run.metrics) {
-    const TrajectoryEvaluation& e = run.metrics->evaluation;
+    const RunMetrics& m = *run.metrics;
+    const TrajectoryEvaluation& e = m.evaluation;
+    if (m.frames_tracked < m.frames_with_ground_truth) {
+      // untracked frames carry guesses: the tracked frames' own figure first, the whole run's beside it
+      const std::string tracked = m.tracked_ate ? fmt::format("{:.3f} m", m.tracked_ate->translation.rmse) : "n/a";
+      fmt::print("  tracked {} of {} frames with ground truth: ATE RMSE {} over those; over all frames (the "
+                 "untracked at their guessed pose):\n", m.frames_tracked, m.frames_with_ground_truth, tracked);
+    }
     fmt::print("  ATE RMSE {:.3f} m, end-point drift {:.2f} %, KITTI metric ({}) {:.2f} % / {:.3f} deg/100m\n",
-               e.ate.translation.rmse, e.drift.percent, run.metrics->kitti_lengths, e.kitti.t_err_percent,
+               e.ate.translation.rmse, e.drift.percent, m.kitti_lengths, e.kitti.t_err_percent,
                e.kitti.r_err_deg_per_100m);
   } else {
     fmt::print("  no ground truth: no accuracy figures\n");
   }
-  fmt::print("  outputs in {}: trajectory_kitti.txt trajectory_tum.txt timing.csv summary.json trajectory.svg "
-             "map.ply\n",
-             out_dir.string());
+  fmt::print("  outputs in {}: {}\n", out_dir.string(),
+             failed ? "timing.csv summary.json (no trajectory: nothing was tracked)"
+                    : "trajectory_kitti.txt trajectory_tum.txt timing.csv summary.json trajectory.svg map.ply");
 }
 
 }  // namespace
@@ -96,7 +104,21 @@ RunResult run_and_report(const Pipeline& pipeline, const std::filesystem::path& 
   const RunResult run = pipeline.run(progress);
   if (!quiet && tty) fmt::print(stderr, "\n");
   write_run_outputs(run, out_dir);
-  print_summary(run, out_dir);
+  // A trajectory of guesses is no result: a failed run, whose trajectory files must not exist (as after
+  // any failure); timing.csv and summary.json stay to tell why.
+  const bool failed = !run.frames.empty() && run.tracked_count() == 0;
+  if (failed) {
+    for (const char* name : {"trajectory_kitti.txt", "trajectory_tum.txt", "trajectory.svg", "map.ply"}) {
+      std::filesystem::remove(out_dir / name);
+    }
+  }
+  print_summary(run, out_dir, failed);
+  if (failed) {
+    throw Error(fmt::format("no frame of {} was tracked ({} not initialised, {} lost); the reasons are printed "
+                            "with -v, per-frame states in {}",
+                            run.frames.size(), run.count(TrackState::NotInitialised), run.count(TrackState::Lost),
+                            (out_dir / "timing.csv").string()));
+  }
   return run;
 }
 

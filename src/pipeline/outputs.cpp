@@ -47,7 +47,12 @@ Json closure_json(const LoopClosure& c) {
 
 Json metrics_json(const RunMetrics& m) {
   const TrajectoryEvaluation& e = m.evaluation;
+  const Json tracked = m.tracked_ate ? Json{{"ate_rmse_m", number(m.tracked_ate->translation.rmse)},
+                                             {"ate_max_m", number(m.tracked_ate->translation.max)}}
+                                     : Json(nullptr);
   return {{"frames_with_ground_truth", m.frames_with_ground_truth},
+          {"frames_tracked", m.frames_tracked},
+          {"tracked", tracked},  // ATE over the tracked frames alone; the figures below cover every frame
           {"path_length_m", number(e.path_length)},
           {"ate_rmse_m", number(e.ate.translation.rmse)},
           {"ate_max_m", number(e.ate.translation.max)},

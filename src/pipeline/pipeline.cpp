@@ -231,6 +231,14 @@ RunResult Pipeline::run(const Progress& progress) const {
     metrics.frames_with_ground_truth = out.ground_truth.size();
     const std::span<const Eigen::Isometry3d> estimate(out.trajectory.poses.data(), out.ground_truth.size());
     metrics.evaluation = evaluate_trajectory(estimate, out.ground_truth);
+    std::vector<Eigen::Isometry3d> tracked, tracked_truth;
+    for (std::size_t i = 0; i < out.ground_truth.size(); ++i) {
+      if (i >= out.frames.size() || !has_pose(out.frames[i].result.state)) continue;
+      tracked.push_back(estimate[i]);
+      tracked_truth.push_back(out.ground_truth[i]);
+    }
+    metrics.frames_tracked = tracked.size();
+    if (tracked.size() >= 2) metrics.tracked_ate = absolute_trajectory_error(tracked, tracked_truth);
     metrics.kitti_lengths = describe_lengths(metrics.evaluation.kitti_options);
     out.metrics = std::move(metrics);
   }
@@ -252,6 +260,11 @@ RunResult Pipeline::run(const Progress& progress) const {
 std::size_t RunResult::count(TrackState state) const {
   return static_cast<std::size_t>(
       std::count_if(frames.begin(), frames.end(), [state](const FrameRecord& r) { return r.result.state == state; }));
+}
+
+std::size_t RunResult::tracked_count() const {
+  return static_cast<std::size_t>(
+      std::count_if(frames.begin(), frames.end(), [](const FrameRecord& r) { return has_pose(r.result.state); }));
 }
 
 std::size_t RunResult::keyframe_count() const {

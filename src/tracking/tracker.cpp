@@ -272,6 +272,10 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
     outcome.need_keyframe = !h.step_rejected && (h.weak || need_keyframe(frame, inliers, mapping_idle));
   } else {
     const bool was_lost = state_ == TrackState::Lost;
+    logger()->debug("frame {}: lost: frame-to-frame motion {} inliers ({} needed), local map {} of {} points in view "
+                    "({} needed){}{}", frame.index, first.motion_inliers, options_.min_pose_inliers, first.local.inliers,
+                    first.local.visible, options_.min_ok_inliers, first.suspect ? ", motion model suspect" : "",
+                    first.relocalisation_tried || !first.motion_ok ? ", no relocalisation in the map" : "");
     state_ = TrackState::Lost;
     velocity_steady_ = false;
     inliers = 0;
@@ -329,7 +333,11 @@ bool Tracker::relocalisation_confirmed(const LocalMapResult& local) const {
 bool Tracker::initialise(Frame& frame, const Eigen::Isometry3d& T_cam_world) {
   const int usable = static_cast<int>(std::count_if(frame.depth_sigma.begin(), frame.depth_sigma.end(),
                                                     [](float s) { return s > 0.0F; }));
-  if (usable < options_.min_initial_depth_points) return false;
+  if (usable < options_.min_initial_depth_points) {
+    logger()->debug("frame {}: not initialised: {} keypoints with usable depth, {} needed "
+                    "(tracker.min_initial_depth_points)", frame.index, usable, options_.min_initial_depth_points);
+    return false;
+  }
   frame.T_cam_world = T_cam_world;
   std::unique_lock lock(map_.mutex());
   const KeyframeId id = map_.add_keyframe(keyframe_from(frame));

@@ -72,3 +72,23 @@ expect_failure("--depth.*'lidar:diamond'" ${seq} --depth lidar:diamond)
 expect_failure("--depth.*'lidar:diamond99999999999'" ${seq} --depth lidar:diamond99999999999)
 expect_failure("--depth.*'lidar:diamond5x'" ${seq} --depth lidar:diamond5x)
 expect_failure("--depth.*'sonar'" ${seq} --depth sonar)
+
+# A run that tracks no frame (100 features: too few with depth to initialise) fails: one error line
+# naming the count, no trajectory files (they would hold only guesses), summary.json and timing.csv
+# kept to tell why.
+file(WRITE ${WORK_DIR}/few.yaml "%YAML:1.0\nORBextractor.nFeatures: 100\n")
+execute_process(COMMAND ${RGBL} --quiet run ${seq} --config ${WORK_DIR}/few.yaml --out ${out_dir}
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("rgbl run with 100 features\n  exit ${rc}: ${err}")
+if(rc EQUAL 0 OR NOT err MATCHES "^error: no frame of 8 was tracked \\(8 not initialised, 0 lost\\)[^\n]*\n$")
+  message(FATAL_ERROR "a run tracking nothing did not fail with one error line")
+endif()
+foreach(name trajectory_kitti.txt trajectory_tum.txt)
+  if(EXISTS ${out_dir}/${name})
+    message(FATAL_ERROR "${out_dir}/${name} exists after a run that tracked nothing")
+  endif()
+endforeach()
+file(READ ${out_dir}/summary.json summary)
+if(NOT summary MATCHES "\"frames_tracked\": 0," OR NOT summary MATCHES "\"tracked\": null")
+  message(FATAL_ERROR "summary.json does not say that no frame was tracked")
+endif()

@@ -59,6 +59,11 @@ TEST_CASE("a pipeline tracks a sequence, re-expresses it in the ground truth's w
   REQUIRE(run.metrics.has_value());
   CHECK(run.metrics->frames_with_ground_truth == 18);
   CHECK(run.metrics->evaluation.ate.translation.rmse < 0.15);
+  // every frame tracked: the tracked frames' figure is the whole run's
+  CHECK(run.tracked_count() == 18);
+  CHECK(run.metrics->frames_tracked == 18);
+  REQUIRE(run.metrics->tracked_ate.has_value());
+  CHECK(run.metrics->tracked_ate->translation.rmse == run.metrics->evaluation.ate.translation.rmse);
   CHECK(run.metrics->kitti_lengths == rgbl::describe_lengths(run.metrics->evaluation.kitti_options));
   CHECK(run.keyframe_count() >= 2);
   CHECK(run.landmarks.size() > 100);
@@ -82,6 +87,8 @@ TEST_CASE("a pipeline tracks a sequence, re-expresses it in the ground truth's w
   CHECK(summary["step"] == 2);
   CHECK(summary["depth"] == "lidar");
   CHECK(summary["metrics"]["ate_rmse_m"].get<double>() == Approx(run.metrics->evaluation.ate.translation.rmse));
+  CHECK(summary["metrics"]["frames_tracked"] == 18);
+  CHECK(summary["metrics"]["tracked"]["ate_rmse_m"].get<double>() == Approx(run.metrics->evaluation.ate.translation.rmse));
   CHECK(summary["stage_ms"]["total"]["median"].get<double>() > 0.0);
   CHECK(summary["loop_closures"].is_array());
   CHECK(summary["min_inliers_ok"] == *run.min_inliers_ok());
@@ -90,6 +97,25 @@ TEST_CASE("a pipeline tracks a sequence, re-expresses it in the ground truth's w
   CHECK(std::count(rows.begin(), rows.end(), '\n') == 18);
   rgbl::remove_run_outputs(out.path() / "run");
   for (const auto& name : rgbl::run_output_files()) CHECK_FALSE(std::filesystem::exists(out.path() / "run" / name));
+}
+
+TEST_CASE("a run that tracks nothing says so in its metrics: no figure for tracked frames") {
+  // 100 features leave fewer keypoints with depth than initialisation needs: no frame is tracked
+  rgbl::test::TempDir dir;
+  dir.write("few.yaml", "%YAML:1.0\nORBextractor.nFeatures: 100\n");
+  auto o = options();
+  o.frames = 6;
+  o.settings = dir.path() / "few.yaml";
+  const rgbl::RunResult run = rgbl::Pipeline(o).run();
+  CHECK(run.count(rgbl::TrackState::NotInitialised) == 6);
+  CHECK(run.tracked_count() == 0);
+  REQUIRE(run.metrics.has_value());
+  CHECK(run.metrics->frames_with_ground_truth == 6);
+  CHECK(run.metrics->frames_tracked == 0);
+  CHECK_FALSE(run.metrics->tracked_ate.has_value());
+  // the all-frames figure is that of the guesses: the start pose held (5 frames of 1 m)
+  CHECK(run.metrics->evaluation.path_length == Approx(5.0).margin(0.5));
+  CHECK(run.metrics->evaluation.drift.percent == Approx(100.0));
 }
 
 TEST_CASE("a pipeline refuses bad options and data it cannot use before the first frame, naming them") {

@@ -63,10 +63,14 @@ struct RunTimings {
   StageStats total;
 };
 
-// Accuracy against the ground truth over the frames it covers.
+// Accuracy against the ground truth over the frames it covers. A frame that was not tracked (lost or
+// not initialised) still has a pose in the trajectory, a guess (extrapolated, or the start): evaluation
+// covers every frame, tracked_ate the tracked ones only (aligned on them).
 struct RunMetrics {
   std::size_t frames_with_ground_truth = 0;
-  TrajectoryEvaluation evaluation;
+  std::size_t frames_tracked = 0;  // of those, tracked (ok or weak)
+  TrajectoryEvaluation evaluation;  // all frames with ground truth
+  std::optional<AteResult> tracked_ate;  // the tracked frames alone, when at least 2 were
   std::string kitti_lengths;  // describe_lengths() of the lengths used
 };
 
@@ -95,6 +99,7 @@ struct RunResult {
   std::optional<RunMetrics> metrics;          // with >= 2 frames of ground truth
 
   std::size_t count(TrackState state) const;
+  std::size_t tracked_count() const;  // frames with a tracked pose (ok or weak)
   std::size_t keyframe_count() const;
   std::optional<int> min_inliers_ok() const;  // fewest local-map inliers on a frame reported ok
   RunTimings timings() const;
