@@ -130,6 +130,7 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
   h.reference = reference_;
   h.relocalisation_frame = last_relocalisation_frame_;
   bool ok = false;
+  std::optional<Frame> weak_start;  // a second start against the reference keyframe (see there)
   if (has_pose(state_)) {
     if (velocity_ && last_frame_) {
       first.motion_inliers =
@@ -138,7 +139,12 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
     }
     if (!ok) {
       clear_matches(frame);
-      ok = track_reference_keyframe(frame);
+      ok = track_reference_keyframe(frame, weak_start);
+      if (!ok && weak_start) {
+        frame = std::move(*weak_start);  // the only start that converged
+        weak_start.reset();
+        ok = true;
+      }
     }
   } else {
     // Recently lost: the frame-to-frame motion (depth RANSAC + temporary points) usually still holds
@@ -161,8 +167,26 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
   first.relocalisation_tried = state_ == TrackState::Lost && !first.motion_ok;
   if (ok) {
     const Frame after_motion = first.motion_ok ? frame : Frame{};
-    first.local = track_local_map(frame, h.reference, h.relocalisation_frame, views);
+    const KeyframeId reference = h.reference;
+    first.local = track_local_map(frame, reference, h.relocalisation_frame, views);
     h.reference = first.local.reference;
+    if (weak_start) {
+      // two starts converged to different poses: the local map decides
+      const LocalMapResult other = track_local_map(*weak_start, reference, h.relocalisation_frame, views);
+      logger()->debug("frame {}: against the reference keyframe, the local map finds {} of {} points from the last "
+                      "pose, {} of {} from the weak depth consensus ({:.2f} m apart)", frame.index,
+                      first.local.inliers, first.local.visible, other.inliers, other.visible,
+                      (frame.T_cam_world.inverse().translation() - weak_start->T_cam_world.inverse().translation()).norm());
+      const double dt = last_frame_ ? frame.timestamp - last_frame_->timestamp : 0.0;
+      // Poses further apart than a vehicle's step tolerance are evidence that contradicts itself,
+      // whichever wins: the frame is weak (and makes a keyframe), never silently ok.
+      h.weak = !check_step(frame.T_cam_world, weak_start->T_cam_world, 0.0, dt, options_).plausible;
+      if (other.inliers > first.local.inliers) {
+        frame = std::move(*weak_start);
+        first.local = other;
+        h.reference = other.reference;
+      }
+    }
     ok = first.local.ok;
     if (ok && h.relocalised && !relocalisation_confirmed(first.local)) {
       logger()->debug("frame {}: relocalisation rejected, the local map re-finds {} of {} points", frame.index,
@@ -473,7 +497,7 @@ int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const
   return inliers;
 }
 
-bool Tracker::track_reference_keyframe(Frame& frame) const {
+bool Tracker::track_reference_keyframe(Frame& frame, std::optional<Frame>& weak_start) const {
   std::vector<Descriptor> train;
   std::vector<LandmarkId> train_landmarks;
   {
@@ -491,23 +515,41 @@ bool Tracker::track_reference_keyframe(Frame& frame) const {
       detail::match_brute_force(frame.descriptors, train, options_.max_hamming, options_.reference_ratio);
   if (static_cast<int>(matches.size()) < options_.reference_min_matches) return false;
   for (const auto& [q, t] : matches) frame.landmarks[static_cast<std::size_t>(q)] = train_landmarks[static_cast<std::size_t>(t)];
-  // Start from the frame-to-frame motion from depth where there is one (the frame right after
-  // initialisation has no velocity yet, and the last pose is then a poor guess at speed).
+  // Start from the frame-to-frame motion from depth where its consensus is strong (the frame right
+  // after initialisation has no velocity yet, and the last pose is then a poor guess at speed), else
+  // from the last pose, and then also from the weak consensus: far off at speed, the last pose can
+  // converge on distant points to a wrong pose that many matches fit (KITTI 04 at 2.5 Hz: 5 m short).
   frame.T_cam_world = last_frame_ ? last_frame_->T_cam_world : Eigen::Isometry3d::Identity();
+  auto start_from = [&](Frame& f, const Eigen::Isometry3d& T_cur_last) {
+    f.T_cam_world = T_cur_last * last_frame_->T_cam_world;
+    // Descriptor matches carry no geometry: those whose 3-D point disagrees with the static
+    // consensus are objects moving against the scene (or aliasing), not evidence for the pose.
+    drop_moving_matches(f);
+  };
   if (last_frame_ && options_.ransac_prediction) {
     TrackerOptions guess_options = options_;  // a guess only: the optimisation below decides
     guess_options.ransac_min_inliers = options_.ransac_guess_min_inliers;
     if (const auto T_cur_last =
             estimate_frame_motion(camera_, *last_frame_, frame, guess_options, trusted_velocity(), &frame.moving)) {
-      frame.T_cam_world = *T_cur_last * last_frame_->T_cam_world;
-      // Descriptor matches carry no geometry: those whose 3-D point disagrees with the static
-      // consensus are objects moving against the scene (or aliasing), not evidence for the pose.
-      drop_moving_matches(frame);
+      start_from(frame, *T_cur_last);
+    } else {
+      weak_start = frame;
+      guess_options.ransac_min_inliers = 3;  // any consensus; the same sampling finds the same motion
+      if (const auto T_weak = estimate_frame_motion(camera_, *last_frame_, *weak_start, guess_options,
+                                                    trusted_velocity(), &weak_start->moving)) {
+        start_from(*weak_start, *T_weak);
+      } else {
+        weak_start.reset();
+      }
     }
   }
-  const int inliers = optimise_pose(frame);
-  discard_outliers(frame);
-  return inliers >= options_.min_pose_inliers;
+  auto optimise = [&](Frame& f) {
+    const int inliers = optimise_pose(f);
+    discard_outliers(f);
+    return inliers >= options_.min_pose_inliers;
+  };
+  if (weak_start && !optimise(*weak_start)) weak_start.reset();
+  return optimise(frame);
 }
 
 bool Tracker::disagrees_with_pose(const Frame& frame, std::size_t i, const Eigen::Vector3d& p_world, double slack) const {

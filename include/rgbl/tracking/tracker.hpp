@@ -119,7 +119,9 @@ class Tracker {
   std::optional<Eigen::Isometry3d> trusted_velocity() const {
     return options_.ransac_motion_prior && velocity_steady_ ? velocity_ : std::nullopt;
   }
-  bool track_reference_keyframe(Frame& frame) const;
+  // Matches the reference keyframe's points by descriptor and optimises the pose. weak_start receives a
+  // second result, from a depth consensus too weak to be the only start, when that converged too.
+  bool track_reference_keyframe(Frame& frame, std::optional<Frame>& weak_start) const;
   // Unmatches keypoints labelled moving and those whose landmark disagrees with frame.T_cam_world (a
   // depth-consensus prediction; see disagrees_with_pose).
   void drop_moving_matches(Frame& frame, double slack = 0.0) const;
