@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <stop_token>
 
 namespace rgbl::cli {
 namespace {
@@ -15,6 +16,10 @@ void print_summary(const RunResult& run, const std::filesystem::path& out_dir) {
   const RunTimings t = run.timings();
   fmt::print("\n{} ({}), camera {}, depth {}: {} frames in {:.1f} s\n", run.sequence_name, to_string(run.format),
              run.camera, run.depth, run.frames.size(), run.wall_s);
+  if (run.stopped) {
+    fmt::print("  PARTIAL: stopped after {} of {} frames; every output holds only these\n", run.frames.size(),
+               run.frames_planned);
+  }
   fmt::print("  ok {}, weak {}, lost {}, not initialised {}; {} keyframes, {} landmarks\n",
              run.count(TrackState::Ok), run.count(TrackState::Weak), run.count(TrackState::Lost),
              run.count(TrackState::NotInitialised), run.keyframe_count(), run.landmarks.size());
@@ -76,12 +81,15 @@ void add_input_options(CLI::App& app, PipelineOptions& options) {
       ->check(CLI::PositiveNumber);
 }
 
-RunResult run_and_report(const Pipeline& pipeline, const std::filesystem::path& out_dir, bool quiet) {
-  remove_run_outputs(out_dir);  // an earlier run's files would look like this one's if it fails
+RunResult run_and_report(const Pipeline& pipeline, const OutputFolder& out_dir, bool quiet,
+                         const InterruptScope& interrupt) {
+  remove_run_outputs(out_dir.path());  // an earlier run's files would look like this one's if it fails
   for (const auto& note : pipeline.notes()) fmt::print(stderr, "note: {}\n", note);
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   Stopwatch wall, clock;
+  std::stop_source stop;
   const auto progress = [&](const FrameRecord& record, std::size_t done, std::size_t total) {
+    if (interrupt.interrupted()) stop.request_stop();  // the signal handler only records the signal
     if (quiet || (clock.elapsed_ms() <= 1000.0 && done != total)) return;
     clock.restart();
     const std::string line =
@@ -93,10 +101,15 @@ RunResult run_and_report(const Pipeline& pipeline, const std::filesystem::path& 
       fmt::print(stderr, "{}\n", line);
     }
   };
-  const RunResult run = pipeline.run(progress);
+  if (interrupt.interrupted()) stop.request_stop();
+  const RunResult run = pipeline.run(progress, stop.get_token());
   if (!quiet && tty) fmt::print(stderr, "\n");
+  if (run.stopped) {
+    fmt::print(stderr, "interrupted by {} after {} of {} frames: writing the partial outputs (summary.json: "
+               "\"partial\": true)\n", interrupt.signal_name(), run.frames.size(), run.frames_planned);
+  }
   write_run_outputs(run, out_dir);
-  print_summary(run, out_dir);
+  print_summary(run, out_dir.path());
   return run;
 }
 
