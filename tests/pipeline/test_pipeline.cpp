@@ -150,7 +150,7 @@ TEST_CASE("a pipeline creates a user's depth source by name and checks what it n
   CHECK_THROWS_WITH(rgbl::Pipeline(o, sources), Contains("depth_camera needs depth images"));
 }
 
-TEST_CASE("a stop requested during a run ends it before the next frame; its outputs say they are partial") {
+TEST_CASE("a stop requested during a run ends it before the next frame, and its outputs say they are partial") {
   const rgbl::Pipeline pipeline(options());
   REQUIRE(pipeline.frame_count() == 40);
   std::stop_source stop;
