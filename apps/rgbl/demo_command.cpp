@@ -22,6 +22,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <system_error>
 
 namespace rgbl::cli {
 namespace {
@@ -86,13 +87,26 @@ int run_demo(const DemoArgs& args, bool quiet) {
     temp.emplace("rgbl_demo");
     root = temp->path();
   } else {
+    // a folder of its own: a KITTI root there (sequences/00, poses/00.txt) would be overwritten
     root = args.keep;
+    std::error_code ec;
+    if (fs::exists(root, ec) && (!fs::is_directory(root, ec) || !fs::is_empty(root, ec))) {
+      throw ConfigError("--keep", fmt::format("a new or empty folder for the generated dataset ({} {})",
+                                              root.string(), fs::is_directory(root, ec) ? "holds files" : "is a file"));
+    }
   }
+  const InterruptScope interrupt;
+  // the output folder before the generation time is spent: one that cannot be written, or that another
+  // run writes into, is refused now
+  const OutputFolder out(args.out);
 
   Stopwatch generation;
   const SyntheticGenerator generator(sim);
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   const KittiLayout layout = write_kitti(generator, root, 0, [&](int i) {
+    interrupt.throw_if_interrupted(args.keep.empty() ? "while generating the street (nothing written)"
+                                                     : "while generating the street (" + root.string() +
+                                                           " holds an incomplete dataset)");
     if (quiet) return;
     const std::string line = fmt::format("generating frame {}/{}", i + 1, sim.frames);
     if (tty) {
@@ -116,7 +130,7 @@ int run_demo(const DemoArgs& args, bool quiet) {
   if (input.depth == "precomputed") input.depth = "precomputed:" + (layout.sequence_dir / "depth").string();
   input.threaded = args.threaded;
   input.loop_closing = !args.no_loop_closing;
-  const RunResult run = run_and_report(Pipeline(input), args.out, quiet);
+  const RunResult run = run_and_report(Pipeline(input), out, quiet, interrupt);
 
   if (temp) {
     fmt::print("  the generated dataset was removed (keep it with --keep <dir>)\n");
@@ -124,6 +138,7 @@ int run_demo(const DemoArgs& args, bool quiet) {
     fmt::print("  dataset kept in {} (ground truth {}; track it again with `rgbl run {}`)\n", root.string(),
                layout.poses_file.string(), layout.sequence_dir.string());
   }
+  if (interrupt.interrupted()) return interrupt.exit_code();  // the partial outputs are written
   // a demo that cannot track its own synthetic street is a failure worth an exit code
   return run.count(TrackState::Ok) > 0 ? 0 : 1;
 }
@@ -150,8 +165,8 @@ Command add_demo_command(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--out", args->out, "Output folder of the run (trajectories, timing, summary, plot, map)")
       ->capture_default_str();
-  app->add_option("--keep", args->keep, "Write the synthetic dataset to this folder and keep it (default: a "
-                                        "temporary folder, removed afterwards)");
+  app->add_option("--keep", args->keep, "Write the synthetic dataset to this new or empty folder and keep it "
+                                        "(default: a temporary folder, removed afterwards)");
   app->add_option("--laps", args->laps, "Laps of --path loop in the frames driven (2: past the start and round again)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();

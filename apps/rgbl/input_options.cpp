@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <stop_token>
 
 namespace rgbl::cli {
 namespace {
@@ -16,6 +17,10 @@ void print_summary(const RunResult& run, const std::filesystem::path& out_dir, b
   const RunTimings t = run.timings();
   fmt::print("\n{} ({}), camera {}, depth {}: {} frames in {:.1f} s\n", run.sequence_name, to_string(run.format),
              run.camera, run.depth, run.frames.size(), run.wall_s);
+  if (run.stopped) {
+    fmt::print("  PARTIAL: stopped after {} of {} frames; every output holds only these\n", run.frames.size(),
+               run.frames_planned);
+  }
   fmt::print("  ok {}, weak {}, lost {}, not initialised {}; {} keyframes, {} landmarks\n",
              run.count(TrackState::Ok), run.count(TrackState::Weak), run.count(TrackState::Lost),
              run.count(TrackState::NotInitialised), run.keyframe_count(), run.landmarks.size());
@@ -84,12 +89,15 @@ void add_input_options(CLI::App& app, PipelineOptions& options) {
       ->check(CLI::PositiveNumber);
 }
 
-RunResult run_and_report(const Pipeline& pipeline, const std::filesystem::path& out_dir, bool quiet) {
-  remove_run_outputs(out_dir);  // an earlier run's files would look like this one's if it fails
+RunResult run_and_report(const Pipeline& pipeline, const OutputFolder& out_dir, bool quiet,
+                         const InterruptScope& interrupt) {
+  remove_run_outputs(out_dir.path());  // an earlier run's files would look like this one's if it fails
   for (const auto& note : pipeline.notes()) fmt::print(stderr, "note: {}\n", note);
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   Stopwatch wall, clock;
+  std::stop_source stop;
   const auto progress = [&](const FrameRecord& record, std::size_t done, std::size_t total) {
+    if (interrupt.interrupted()) stop.request_stop();  // the signal handler only records the signal
     if (quiet || (clock.elapsed_ms() <= 1000.0 && done != total)) return;
     clock.restart();
     const std::string line =
@@ -101,23 +109,28 @@ RunResult run_and_report(const Pipeline& pipeline, const std::filesystem::path& 
       fmt::print(stderr, "{}\n", line);
     }
   };
-  const RunResult run = pipeline.run(progress);
+  if (interrupt.interrupted()) stop.request_stop();
+  const RunResult run = pipeline.run(progress, stop.get_token());
   if (!quiet && tty) fmt::print(stderr, "\n");
+  if (run.stopped) {
+    fmt::print(stderr, "interrupted by {} after {} of {} frames: writing the partial outputs (summary.json: "
+               "\"partial\": true)\n", interrupt.signal_name(), run.frames.size(), run.frames_planned);
+  }
   write_run_outputs(run, out_dir);
   // A trajectory of guesses is no result: a failed run, whose trajectory files must not exist (as after
   // any failure); timing.csv and summary.json stay to tell why.
-  const bool failed = !run.frames.empty() && run.tracked_count() == 0;
+  const bool failed = !run.stopped && !run.frames.empty() && run.tracked_count() == 0;
   if (failed) {
     for (const char* name : {"trajectory_kitti.txt", "trajectory_tum.txt", "trajectory.svg", "map.ply"}) {
-      std::filesystem::remove(out_dir / name);
+      std::filesystem::remove(out_dir.path() / name);
     }
   }
-  print_summary(run, out_dir, failed);
+  print_summary(run, out_dir.path(), failed);
   if (failed) {
     throw Error(fmt::format("no frame of {} was tracked ({} not initialised, {} lost); the reasons are printed "
                             "with -v, per-frame states in {}",
                             run.frames.size(), run.count(TrackState::NotInitialised), run.count(TrackState::Lost),
-                            (out_dir / "timing.csv").string()));
+                            (out_dir.path() / "timing.csv").string()));
   }
   return run;
 }

@@ -1,5 +1,6 @@
 // rgbl: the command-line front end. Subcommands are in <name>_command.cpp (see command.hpp).
 #include "command.hpp"
+#include "interrupt.hpp"
 #include "rgbl/core/log.hpp"
 #include "rgbl/version.hpp"
 
@@ -8,12 +9,29 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <cerrno>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <memory>
 #include <vector>
 
-int main(int argc, char** argv) {
+namespace {
+
+// Everything printed to stdout must have arrived: a full disk or a closed pipe is a failure, not a
+// success with a truncated report. Returns the exit code.
+int check_stdout(int code) {
+  errno = 0;
+  const bool flushed = std::fflush(stdout) == 0;
+  if (flushed && std::ferror(stdout) == 0) return code;
+  const int error = errno;
+  fmt::print(stderr, "error: cannot write to standard output{}\n",
+             error != 0 ? fmt::format(" ({})", std::strerror(error)) : std::string());
+  return code == 0 ? 1 : code;
+}
+
+int run(int argc, char** argv) {
   CLI::App app{"rgbl: LiDAR-enhanced visual SLAM (RGB-L) on KITTI and TUM data, and trajectory evaluation."};
   app.require_subcommand(1, 1);
   app.footer("Run `rgbl <command> --help` for a command's options.");
@@ -50,6 +68,9 @@ int main(int argc, char** argv) {
     }
     std::fputs("error: no command given (see rgbl --help)\n", stderr);
     return 2;
+  } catch (const rgbl::cli::Interrupted& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return e.exit_code();
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return 1;
@@ -57,4 +78,13 @@ int main(int argc, char** argv) {
     std::fputs("error: unknown failure\n", stderr);
     return 1;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // a closed pipe on stdout (or a FIFO's reader gone) is an EPIPE error to report, not a silent death
+  std::signal(SIGPIPE, SIG_IGN);
+  const int code = run(argc, argv);
+  return check_stdout(code);
 }

@@ -19,11 +19,16 @@ Command add_run_command(CLI::App& parent) {
   app->add_flag("--no-loop-closing", *no_loop_closing,
                 "Do not close loops (default: closed on every keyframe, inline, or in a thread of its own with --threaded)");
   return {app, [options, out_dir, no_loop_closing, app] {
-            remove_run_outputs(*out_dir);  // before anything can fail: stale outputs would look like this run's
+            const InterruptScope interrupt;
+            // first of all: a folder that cannot be written, or that another run writes into, is refused
+            // before any work (and before this run removes anything there)
+            const OutputFolder out(*out_dir);
+            remove_run_outputs(out.path());  // before anything can fail: stale outputs would look like this run's
             options->loop_closing = !*no_loop_closing;
             const Pipeline pipeline(*options);
-            run_and_report(pipeline, *out_dir, app->get_parent()->get_option("--quiet")->as<bool>());
-            return 0;
+            run_and_report(pipeline, out, app->get_parent()->get_option("--quiet")->as<bool>(), interrupt);
+            // outputs written, partial or not: an interrupted run still exits 128 + the signal
+            return interrupt.interrupted() ? interrupt.exit_code() : 0;
           }};
 }
 

@@ -2,45 +2,179 @@
 
 #include "rgbl/core/error.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
+#include <random>
 #include <system_error>
 
 namespace rgbl {
+namespace {
 
-void write_atomically(const std::filesystem::path& file, const std::function<void(std::ofstream&)>& write) {
-  auto tmp = file;
-  tmp += ".part";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(fmt::format("{}: cannot open for writing", file.string()));
-    write(out);
-    out.flush();
-    if (!out) {
-      out.close();
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw Error(fmt::format("{}: write failed (disk full?)", file.string()));
-    }
+namespace fs = std::filesystem;
+
+std::string errno_text(int error) { return std::generic_category().message(error); }
+
+// Closes the descriptor it owns.
+class FileDescriptor {
+ public:
+  explicit FileDescriptor(int fd) : fd_(fd) {}
+  ~FileDescriptor() {
+    if (fd_ >= 0) ::close(fd_);
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw Error(fmt::format("{}: cannot move the finished file into place", file.string()));
+  FileDescriptor(const FileDescriptor&) = delete;
+  FileDescriptor& operator=(const FileDescriptor&) = delete;
+  int get() const { return fd_; }
+
+ private:
+  int fd_;
+};
+
+// Creates (O_EXCL) a file named <prefix>.<random><suffix> in `folder` that no one else uses, mode 0666
+// less the umask as for any new file; returns its path, or the errno of the failure.
+std::pair<fs::path, int> create_unique(const fs::path& folder, const std::string& prefix, const std::string& suffix) {
+  std::random_device random;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const fs::path candidate = folder / fmt::format("{}.{:08x}{}", prefix, random(), suffix);
+    const FileDescriptor fd(::open(candidate.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666));
+    if (fd.get() >= 0) return {candidate, 0};
+    if (errno != EEXIST) return {fs::path(), errno};
+  }
+  return {fs::path(), EEXIST};
+}
+
+// Runs write() on `out` and checks the stream afterwards; throws Error naming `file`.
+void write_and_check(const fs::path& file, std::ofstream& out, const std::function<void(std::ofstream&)>& write) {
+  errno = 0;
+  write(out);
+  out.flush();
+  if (!out) {
+    const int error = errno;
+    throw Error(fmt::format("{}: write failed ({})", file.string(), error != 0 ? errno_text(error) : "disk full?"));
   }
 }
 
+// Not a regular file (a FIFO, a device, a link to one, a dangling link): written through, as `> file`
+// in a shell would, so that the node stays what it is.
+void write_through(const fs::path& file, bool fifo, const std::function<void(std::ofstream&)>& write) {
+  // a FIFO without a reader would block the open for ever: held open (non-blocking) while the stream
+  // opens, it also spares that open the wait
+  const FileDescriptor reader_check(fifo ? ::open(file.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC) : -1);
+  if (fifo && reader_check.get() < 0) {
+    if (errno == ENXIO) {
+      throw Error(fmt::format("{}: a FIFO with no reader (start the program that reads it first)", file.string()));
+    }
+    throw Error(fmt::format("{}: cannot open for writing ({})", file.string(), errno_text(errno)));
+  }
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  if (!out) throw Error(fmt::format("{}: cannot open for writing ({})", file.string(), errno_text(errno)));
+  write_and_check(file, out, write);
+}
+
+// A regular file (or a new one): written to a temporary next to it and renamed over it.
+void replace(const fs::path& file, const struct stat* existing, const std::function<void(std::ofstream&)>& write) {
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  const auto [tmp, error] = create_unique(folder, file.filename().string(), ".part");
+  if (tmp.empty()) throw Error(fmt::format("{}: cannot open for writing ({})", file.string(), errno_text(error)));
+  try {
+    // the replacement keeps the permissions of the file it replaces
+    if (existing != nullptr) ::chmod(tmp.c_str(), existing->st_mode & 07777);
+    {
+      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+      if (!out) throw Error(fmt::format("{}: cannot open for writing ({})", file.string(), errno_text(errno)));
+      write_and_check(file, out, write);
+      out.close();
+      if (!out) throw Error(fmt::format("{}: write failed ({})", file.string(), errno_text(errno)));
+    }
+    std::error_code ec;
+    fs::rename(tmp, file, ec);
+    if (ec) {
+      throw Error(fmt::format("{}: cannot move the finished file into place ({})", file.string(), ec.message()));
+    }
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(tmp, ec);  // never a *.part left behind, whatever failed
+    throw;
+  }
+}
+
+}  // namespace
+
+void write_atomically(const fs::path& file, const std::function<void(std::ofstream&)>& write) {
+  struct stat target {};
+  if (::stat(file.c_str(), &target) == 0) {  // follows links: what `file` finally is
+    if (S_ISDIR(target.st_mode)) throw Error(fmt::format("{}: is a folder (expected a file to write)", file.string()));
+    if (!S_ISREG(target.st_mode)) return write_through(file, S_ISFIFO(target.st_mode), write);
+    struct stat link {};
+    if (::lstat(file.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) {
+      // replace the file the link points to and keep the link; a link that does not resolve to that
+      // file by path (/proc/self/fd/N of a deleted file) is written through
+      std::error_code ec;
+      const fs::path resolved = fs::canonical(file, ec);
+      struct stat again {};
+      if (ec || ::stat(resolved.c_str(), &again) != 0 || again.st_dev != target.st_dev ||
+          again.st_ino != target.st_ino) {
+        return write_through(file, false, write);
+      }
+      return replace(resolved, &target, write);
+    }
+    return replace(file, &target, write);
+  }
+  struct stat link {};
+  if (::lstat(file.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) {
+    return write_through(file, false, write);  // a dangling link: create the file it names
+  }
+  replace(file, nullptr, write);
+}
+
+OutputFolder::OutputFolder(fs::path folder) : path_(std::move(folder)) {
+  std::error_code ec;
+  fs::create_directories(path_, ec);
+  if (ec || !fs::is_directory(path_, ec)) {
+    throw Error(fmt::format("{}: cannot create the output folder ({})", path_.string(),
+                            ec ? ec.message() : "a file of that name exists"));
+  }
+  fd_ = ::open(path_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd_ < 0) throw Error(fmt::format("{}: cannot open the output folder ({})", path_.string(), errno_text(errno)));
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int error = errno;
+    ::close(fd_);
+    fd_ = -1;
+    if (error == EWOULDBLOCK) {
+      throw Error(fmt::format("{}: another rgbl process is writing into this output folder (wait for it to finish, "
+                              "or choose another folder)",
+                              path_.string()));
+    }
+    throw Error(fmt::format("{}: cannot lock the output folder ({})", path_.string(), errno_text(error)));
+  }
+  // writable: a probe file created and removed (access(2) says yes to root on a read-only mount)
+  const auto [probe, error] = create_unique(path_, ".rgbl-write-test", "");
+  if (probe.empty()) {
+    ::close(fd_);
+    fd_ = -1;
+    throw Error(fmt::format("{}: cannot write into the output folder ({})", path_.string(), errno_text(error)));
+  }
+  fs::remove(probe, ec);
+}
+
+OutputFolder::~OutputFolder() {
+  if (fd_ >= 0) ::close(fd_);  // releases the lock
+}
+
 TemporaryFolder::TemporaryFolder(const std::string& prefix) {
-  std::string pattern = (std::filesystem::temp_directory_path() / (prefix + "_XXXXXX")).string();
+  std::string pattern = (fs::temp_directory_path() / (prefix + "_XXXXXX")).string();
   if (::mkdtemp(pattern.data()) == nullptr) throw Error(fmt::format("{}: cannot create a temporary folder", pattern));
   path_ = pattern;
 }
 
 TemporaryFolder::~TemporaryFolder() {
   std::error_code ec;
-  std::filesystem::remove_all(path_, ec);
+  fs::remove_all(path_, ec);
 }
 
 }  // namespace rgbl

@@ -1,6 +1,7 @@
 #include "rgbl/io/svg_plot.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 
 #include <fmt/format.h>
 
@@ -152,10 +153,8 @@ std::string trajectory_svg(const std::vector<PlotSeries>& series, const std::str
 void write_trajectory_svg(const std::filesystem::path& path, const std::vector<PlotSeries>& series,
                           const std::string& title, const std::vector<PlotLink>& links,
                           const std::string& links_label) {
-  std::ofstream out(path);
-  if (!out) throw Error(fmt::format("{}: cannot write the trajectory plot", path.string()));
-  out << trajectory_svg(series, title, links, links_label);
-  if (!out) throw Error(fmt::format("{}: writing the trajectory plot failed", path.string()));
+  const std::string svg = trajectory_svg(series, title, links, links_label);
+  write_atomically(path, [&](std::ofstream& out) { out << svg; });
 }
 
 }  // namespace rgbl

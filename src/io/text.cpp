@@ -52,6 +52,11 @@ void for_each_record(const std::filesystem::path& file, std::string_view what, s
                      std::string_view record,
                      const std::function<void(std::size_t line_no, std::span<const double> numbers)>& on_record) {
   auto in = open_for_reading(file, what);
+  for_each_record(in, file, count, record, on_record);
+}
+
+void for_each_record(std::istream& in, const std::filesystem::path& file, std::size_t count, std::string_view record,
+                     const std::function<void(std::size_t line_no, std::span<const double> numbers)>& on_record) {
   std::vector<double> numbers(count);
   std::string line;
   std::size_t line_no = 0;

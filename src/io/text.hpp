@@ -29,6 +29,10 @@ void for_each_record(const std::filesystem::path& file, std::string_view what, s
                      std::string_view record,
                      const std::function<void(std::size_t line_no, std::span<const double> numbers)>& on_record);
 
+// The same on a stream already open; `file` names it in errors.
+void for_each_record(std::istream& in, const std::filesystem::path& file, std::size_t count, std::string_view record,
+                     const std::function<void(std::size_t line_no, std::span<const double> numbers)>& on_record);
+
 // Sorted indices of files named <digits><extension> in `dir`, keyed by their number.
 std::vector<std::size_t> numbered_files(const std::filesystem::path& dir, std::string_view extension);
 

@@ -40,8 +40,13 @@ void write_kitti_trajectory(const std::filesystem::path& file, std::span<const E
 }
 
 std::vector<Eigen::Isometry3d> read_kitti_trajectory(const std::filesystem::path& file) {
+  auto in = detail::open_for_reading(file, "a KITTI trajectory: 12 numbers per line");
+  return read_kitti_trajectory(in, file);
+}
+
+std::vector<Eigen::Isometry3d> read_kitti_trajectory(std::istream& in, const std::filesystem::path& file) {
   std::vector<Eigen::Isometry3d> poses;
-  detail::for_each_record(file, "a KITTI trajectory: 12 numbers per line", 12, "12 numbers (a row-major 3x4 pose)",
+  detail::for_each_record(in, file, 12, "12 numbers (a row-major 3x4 pose)",
                           [&](std::size_t line_no, std::span<const double> v) {
                             Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
                             for (int k = 0; k < 12; ++k) T.matrix()(k / 4, k % 4) = v[static_cast<std::size_t>(k)];
@@ -71,9 +76,14 @@ void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& t
 }
 
 Trajectory read_tum_trajectory(const std::filesystem::path& file) {
+  auto in = detail::open_for_reading(file, "a TUM trajectory: 't tx ty tz qx qy qz qw' per line");
+  return read_tum_trajectory(in, file);
+}
+
+Trajectory read_tum_trajectory(std::istream& in, const std::filesystem::path& file) {
   Trajectory trajectory;
   detail::for_each_record(
-      file, "a TUM trajectory: 't tx ty tz qx qy qz qw' per line", 8, "8 numbers 't tx ty tz qx qy qz qw'",
+      in, file, 8, "8 numbers 't tx ty tz qx qy qz qw'",
       [&](std::size_t line_no, std::span<const double> v) {
         Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
         if (std::abs(q.norm() - 1.0) > 1e-3) {

@@ -9,6 +9,8 @@
 
 #include <cmath>
 #include <fstream>
+#include <sstream>
+#include <system_error>
 
 namespace rgbl {
 namespace {
@@ -29,10 +31,33 @@ void CompareOptions::validate() const {
   require(max_time_difference >= 0.0, "--max-dt", "a time difference >= 0 s");
 }
 
-// "kitti" (12 numbers per row) or "tum" (8), from the first data row.
-std::string detect_trajectory_format(const std::filesystem::path& file) {
-  std::ifstream in(file);
+namespace {
+
+// The whole file, read once: `rgbl eval <(cmd) gt` hands over a pipe, which cannot be read twice
+// (detecting the format, then parsing).
+std::stringstream read_once(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) {
+    throw ParseError(file, 0, "is a directory (expected a KITTI or TUM trajectory)");
+  }
+  std::ifstream in(file, std::ios::binary);
   if (!in) throw ParseError(file, 0, "cannot open the file (expected a KITTI or TUM trajectory)");
+  std::stringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw ParseError(file, 0, "cannot read the file (expected a KITTI or TUM trajectory)");
+  text.clear();  // an empty file sets failbit on the copy
+  return text;
+}
+
+}  // namespace
+
+std::string detect_trajectory_format(const std::filesystem::path& file) {
+  std::stringstream text = read_once(file);
+  return detect_trajectory_format(text, file);
+}
+
+// "kitti" (12 numbers per row) or "tum" (8), from the first data row.
+std::string detect_trajectory_format(std::istream& in, const std::filesystem::path& file) {
   std::string line;
   std::size_t line_no = 0;
   while (std::getline(in, line)) {
@@ -63,8 +88,18 @@ TrajectoryComparison compare_trajectory_files(const std::filesystem::path& estim
   TrajectoryComparison c;
   c.estimate = estimate;
   c.ground_truth = ground_truth;
-  const std::string est_format = options.format == "auto" ? detect_trajectory_format(estimate) : options.format;
-  const std::string gt_format = options.format == "auto" ? detect_trajectory_format(ground_truth) : options.format;
+  // each file read once, then detected and parsed from memory
+  std::stringstream est_text = read_once(estimate);
+  std::stringstream gt_text = read_once(ground_truth);
+  const auto format_of = [&](std::stringstream& text, const std::filesystem::path& file) {
+    if (options.format != "auto") return options.format;
+    std::string format = detect_trajectory_format(text, file);
+    text.clear();
+    text.seekg(0);
+    return format;
+  };
+  const std::string est_format = format_of(est_text, estimate);
+  const std::string gt_format = format_of(gt_text, ground_truth);
   if (est_format != gt_format) {
     throw Error(fmt::format("{} is a {} trajectory but {} is a {} one: convert one of them (or pass --format)",
                             estimate.string(), est_format, ground_truth.string(), gt_format));
@@ -72,8 +107,8 @@ TrajectoryComparison compare_trajectory_files(const std::filesystem::path& estim
   c.format = est_format;
   std::vector<Eigen::Isometry3d> est, gt;
   if (est_format == "kitti") {
-    est = read_kitti_trajectory(estimate);
-    gt = read_kitti_trajectory(ground_truth);
+    est = read_kitti_trajectory(est_text, estimate);
+    gt = read_kitti_trajectory(gt_text, ground_truth);
     c.estimated_poses = est.size();
     if (gt.size() < est.size()) {
       throw ParseError(ground_truth, 0,
@@ -85,8 +120,8 @@ TrajectoryComparison compare_trajectory_files(const std::filesystem::path& estim
       gt.resize(est.size());
     }
   } else {
-    const Trajectory e = read_tum_trajectory(estimate);
-    const Trajectory g = read_tum_trajectory(ground_truth);
+    const Trajectory e = read_tum_trajectory(est_text, estimate);
+    const Trajectory g = read_tum_trajectory(gt_text, ground_truth);
     c.estimated_poses = e.size();
     const auto pairs = associate_timestamps(e.timestamps, g.timestamps, options.max_time_difference);
     for (const auto& [i, j] : pairs) {
@@ -136,7 +171,8 @@ std::string comparison_json(const TrajectoryComparison& c) {
                      {"rpe_translation_m", stats_json(e.rpe.translation)},
                      {"rpe_rotation_deg", stats_json(e.rpe.rotation_deg)},
                      {"drift", {{"end_error_m", number(e.drift.end_error)}, {"percent", number(e.drift.percent)}}}};
-  return json.dump(2) + "\n";
+  // a path that is not UTF-8 is written with replacement characters rather than failing the report
+  return json.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace rgbl

@@ -112,8 +112,9 @@ void write_plot(const RunResult& run, const std::filesystem::path& file) {
     links.push_back({poses[current->second].translation(), poses[matched->second].translation(),
                      fmt::format("{}-{}", c.frame_index, c.matched_frame_index)});
   }
-  write_trajectory_svg(file, series, fmt::format("{}: camera {}, depth {}", run.sequence_name, run.camera, run.depth),
-                       links);
+  std::string title = fmt::format("{}: camera {}, depth {}", run.sequence_name, run.camera, run.depth);
+  if (run.stopped) title += fmt::format(" (partial: stopped after {} of {} frames)", run.frames.size(), run.frames_planned);
+  write_trajectory_svg(file, series, title, links);
 }
 
 }  // namespace
@@ -146,6 +147,9 @@ std::string summary_json(const RunResult& run) {
   j["first_frame"] = run.first;
   j["step"] = run.step;
   j["frames"] = run.frames.size();
+  // a run stopped before its last frame (Ctrl-C): every output holds only the frames tracked
+  j["partial"] = run.stopped;
+  j["frames_planned"] = run.frames_planned;
   j["tracked"] = run.count(TrackState::Ok);
   j["weak"] = run.count(TrackState::Weak);
   j["lost"] = run.count(TrackState::Lost);
@@ -176,13 +180,16 @@ std::string summary_json(const RunResult& run) {
                    {"depth_extraction_tracking", stage(t.front)},
                    {"total", stage(t.total)}};
   j["metrics"] = run.metrics ? metrics_json(*run.metrics) : Json(nullptr);
-  return j.dump(2) + "\n";
+  // a path that is not UTF-8 is written with replacement characters rather than failing the outputs
+  return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
 void write_run_outputs(const RunResult& run, const std::filesystem::path& out_dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(out_dir, ec);
-  if (ec) throw Error(fmt::format("{}: cannot create the output folder ({})", out_dir.string(), ec.message()));
+  write_run_outputs(run, OutputFolder(out_dir));
+}
+
+void write_run_outputs(const RunResult& run, const OutputFolder& folder) {
+  const std::filesystem::path& out_dir = folder.path();
   write_kitti_trajectory(out_dir / "trajectory_kitti.txt", run.trajectory.poses);
   write_tum_trajectory(out_dir / "trajectory_tum.txt", run.trajectory);
   // the ground truth of the frames run, row for row with trajectory_kitti.txt (for evo and plots; a

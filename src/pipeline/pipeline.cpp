@@ -177,7 +177,7 @@ SensorFrame Pipeline::sensor_frame(const FrameInput& input) const {
   return frame;
 }
 
-RunResult Pipeline::run(const Progress& progress) const {
+RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
   System system(system_, context_.calibration, make_depth_source(), make_extractor());
   RunResult out;
   out.sequence_name = sequence_->name();
@@ -191,8 +191,13 @@ RunResult Pipeline::run(const Progress& progress) const {
 
   ReadAhead frames(*sequence_, read_ahead_options());
   out.frames.reserve(count_);
+  out.frames_planned = count_;
   Stopwatch wall;
   for (;;) {
+    if (stop.stop_requested()) {
+      out.stopped = out.frames.size() < count_;
+      break;
+    }
     Stopwatch wait;
     std::optional<FrameInput> input = frames.next();
     const double wait_ms = wait.elapsed_ms();

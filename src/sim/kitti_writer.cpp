@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <system_error>
 
 namespace rgbl {
 namespace {
@@ -17,6 +18,15 @@ class SequenceWriter {
   SequenceWriter(const std::filesystem::path& root, int sequence, const SyntheticOptions& options,
                  const KittiCalibration& calibration)
       : layout_(kitti_layout(root, sequence)) {
+    // never over another sequence: its images, scans and ground truth would be replaced file by file
+    for (const auto& existing : {layout_.sequence_dir, layout_.poses_file}) {
+      std::error_code ec;
+      if (std::filesystem::exists(std::filesystem::symlink_status(existing, ec))) {
+        throw Error(fmt::format("{}: exists; a synthetic sequence is written only where it replaces nothing "
+                                "(choose a new or empty folder, or another sequence number)",
+                                existing.string()));
+      }
+    }
     // only the folders of what is rendered: the KITTI loader takes a camera folder as the camera's presence
     for (std::size_t c = 0; c < 4; ++c) {
       if (options.cameras[c]) std::filesystem::create_directories(layout_.sequence_dir / fmt::format("image_{}", c));

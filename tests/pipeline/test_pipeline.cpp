@@ -1,4 +1,5 @@
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 #include "rgbl/pipeline/pipeline.hpp"
 #include "rgbl/sim/synthetic.hpp"
 #include "support/data.hpp"
@@ -8,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <stop_token>
 
 using Catch::Matchers::Contains;
 
@@ -195,4 +197,50 @@ TEST_CASE("a pipeline creates a user's depth source by name and checks what it n
                                }});
   o.depth = "depth_camera";
   CHECK_THROWS_WITH(rgbl::Pipeline(o, sources), Contains("depth_camera needs depth images"));
+}
+
+TEST_CASE("a stop requested during a run ends it before the next frame, and its outputs say they are partial") {
+  const rgbl::Pipeline pipeline(options());
+  REQUIRE(pipeline.frame_count() == 40);
+  std::stop_source stop;
+  const rgbl::RunResult run = pipeline.run(
+      [&](const rgbl::FrameRecord&, std::size_t done, std::size_t) {
+        if (done == 6) stop.request_stop();  // as the CLI does on Ctrl-C
+      },
+      stop.get_token());
+  CHECK(run.stopped);
+  CHECK(run.frames_planned == 40);
+  REQUIRE(run.frames.size() == 6);
+  CHECK(run.trajectory.poses.size() == 6);
+  CHECK(run.ground_truth.size() == 6);
+
+  rgbl::test::TempDir out;
+  rgbl::write_run_outputs(run, out.path() / "run");
+  const auto summary = nlohmann::json::parse(rgbl::test::read_file(out.path() / "run" / "summary.json"));
+  CHECK(summary["partial"] == true);
+  CHECK(summary["frames"] == 6);
+  CHECK(summary["frames_planned"] == 40);
+  CHECK_THAT(rgbl::test::read_file(out.path() / "run" / "trajectory.svg"), Contains("partial: stopped after 6 of 40"));
+
+  // a run not stopped says so too
+  const rgbl::RunResult whole = rgbl::Pipeline([] {
+                                  auto o = options();
+                                  o.frames = 3;
+                                  return o;
+                                }()).run();
+  CHECK_FALSE(whole.stopped);
+  CHECK(nlohmann::json::parse(rgbl::summary_json(whole))["partial"] == false);
+}
+
+TEST_CASE("run outputs are refused before the run when another process writes into the folder") {
+  rgbl::test::TempDir out;
+  const rgbl::OutputFolder held(out.path() / "run");
+  const rgbl::RunResult run = rgbl::Pipeline([] {
+                                auto o = options();
+                                o.frames = 3;
+                                return o;
+                              }()).run();
+  CHECK_THROWS_WITH(rgbl::write_run_outputs(run, out.path() / "run"), Contains("another rgbl process"));
+  rgbl::write_run_outputs(run, held);  // the holder writes
+  CHECK(std::filesystem::exists(out.path() / "run" / "summary.json"));
 }

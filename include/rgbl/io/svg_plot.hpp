@@ -28,7 +28,8 @@ struct PlotLink {
 std::string trajectory_svg(const std::vector<PlotSeries>& series, const std::string& title,
                            const std::vector<PlotLink>& links = {}, const std::string& links_label = "loop closure");
 
-// Writes trajectory_svg() to `path`; throws rgbl::Error naming the file when it cannot be written.
+// Writes trajectory_svg() to `path` whole (write_atomically); throws rgbl::Error naming the file when it
+// cannot be written.
 void write_trajectory_svg(const std::filesystem::path& path, const std::vector<PlotSeries>& series,
                           const std::string& title, const std::vector<PlotLink>& links = {},
                           const std::string& links_label = "loop closure");

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <istream>
 #include <span>
 #include <utility>
 #include <vector>
@@ -32,6 +33,9 @@ std::vector<Eigen::Isometry3d> read_kitti_trajectory(const std::filesystem::path
 // timestamps.size() must equal poses.size().
 void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& trajectory);
 Trajectory read_tum_trajectory(const std::filesystem::path& file);
+// The same from a stream already open (a pipe or a FIFO can be read only once); `file` names it in errors.
+std::vector<Eigen::Isometry3d> read_kitti_trajectory(std::istream& in, const std::filesystem::path& file);
+Trajectory read_tum_trajectory(std::istream& in, const std::filesystem::path& file);
 
 // Pairs (i, j) with |a[i] - b[j]| <= max_difference, chosen greedily by smallest difference as TUM's
 // associate.py does; each index used at most once; sorted by i. Both lists must be sorted ascending.

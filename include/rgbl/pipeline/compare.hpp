@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -30,8 +31,10 @@ struct TrajectoryComparison {
 
 // "kitti" or "tum" from the first data row. Throws ParseError naming the file and line.
 std::string detect_trajectory_format(const std::filesystem::path& file);
+// The same from a stream already open (a pipe can be read only once); `file` names it in errors.
+std::string detect_trajectory_format(std::istream& in, const std::filesystem::path& file);
 
-// Reads both files and pairs them: KITTI by row (the ground truth may be longer), TUM by timestamp.
+// Reads both files (each once: a pipe or a FIFO works) and pairs them: KITTI by row (the ground truth may be longer), TUM by timestamp.
 // Throws ParseError / Error naming the files for mixed formats, a shorter ground truth, or fewer than
 // 2 pairs.
 TrajectoryComparison compare_trajectory_files(const std::filesystem::path& estimate,

@@ -23,10 +23,13 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stop_token>
 #include <string>
 #include <vector>
 
 namespace rgbl {
+
+class OutputFolder;
 
 struct PipelineOptions {
   std::filesystem::path dataset;  // KITTI odometry sequences/NN, KITTI raw drive or TUM RGB-D folder
@@ -89,6 +92,8 @@ struct RunResult {
   bool loop_closing = false;
 
   std::vector<FrameRecord> frames;
+  std::size_t frames_planned = 0;  // what the run was to track; more than frames.size() when stopped
+  bool stopped = false;            // stopped on request before the last frame: every output is partial
   Trajectory trajectory;                        // a pose per frame, corrected by every loop closure
   std::vector<Eigen::Isometry3d> ground_truth;  // rows of `trajectory` that have ground truth (from the first)
   std::vector<LoopClosure> loop_closures;
@@ -147,7 +152,9 @@ class Pipeline {
   using Progress = std::function<void(const FrameRecord& record, std::size_t done, std::size_t total)>;
   // Tracks every frame (the next ones loaded on a second thread), waits for threaded mapping and loop
   // closing, and evaluates. Throws what loading a frame throws (ParseError naming the file).
-  RunResult run(const Progress& progress = {}) const;
+  // A stop requested on `stop` (from the progress callback, another thread, a signal's watcher) ends
+  // the run before the next frame: the result then holds what was tracked, with stopped set.
+  RunResult run(const Progress& progress = {}, std::stop_token stop = {}) const;
 
  private:
   PipelineOptions options_;
@@ -170,11 +177,16 @@ const std::vector<std::string>& run_output_files();
 // run's if this one fails).
 void remove_run_outputs(const std::filesystem::path& out_dir);
 
-// Writes into `out_dir` (created): trajectory_kitti.txt, trajectory_tum.txt, ground_truth_kitti.txt
-// (with ground truth; row for row with trajectory_kitti.txt), timing.csv (a row per frame, a column
-// per stage), summary.json, trajectory.svg (with the ground truth and the loop closures) and map.ply
-// (landmarks and keyframes). Each file is written whole and renamed into place.
+// Writes into `out_dir` (created, and locked against other processes while writing: OutputFolder):
+// trajectory_kitti.txt, trajectory_tum.txt, ground_truth_kitti.txt (with ground truth; row for row
+// with trajectory_kitti.txt), timing.csv (a row per frame, a column per stage), summary.json,
+// trajectory.svg (with the ground truth and the loop closures) and map.ply (landmarks and keyframes).
+// Each file is written whole and renamed into place (write_atomically). A stopped run's summary.json
+// says "partial": true.
 void write_run_outputs(const RunResult& result, const std::filesystem::path& out_dir);
+// The same into a folder the caller holds (taken before the run, so that an unusable or busy folder is
+// found before tracking).
+void write_run_outputs(const RunResult& result, const OutputFolder& out_dir);
 
 // summary.json's content.
 std::string summary_json(const RunResult& result);

@@ -207,7 +207,8 @@ KittiLayout kitti_layout(const std::filesystem::path& root, int sequence);
 //   times.txt, depth/NNNNNN.png (uint16 = depth * 256 of options.depth_camera; 0 where nothing was hit
 //   or beyond 255.99 m), sim.txt (the generator's options), and poses/NN.txt.
 // Frames are rendered and written one by one; `on_frame(i)` is called after each. Throws rgbl::Error
-// naming the file when a file cannot be written.
+// naming the file when a file cannot be written, or before writing anything when sequences/NN or
+// poses/NN.txt already exists (it never overwrites a dataset).
 KittiLayout write_kitti(const SyntheticGenerator& generator, const std::filesystem::path& root, int sequence = 0,
                         const std::function<void(int)>& on_frame = {});
 KittiLayout write_kitti(const SyntheticSequence& sequence, const std::filesystem::path& root, int sequence_number = 0);
