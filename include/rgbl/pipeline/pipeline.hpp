@@ -144,6 +144,13 @@ class Pipeline {
   // closing, and evaluates. Throws what loading a frame throws (ParseError naming the file).
   RunResult run(const Progress& progress = {}) const;
 
+  // run() in parts, for a caller that feeds the frames itself (the Python module): the System run()
+  // tracks with, and the RunResult of the frames it tracked (after system.finish()), re-expressed in
+  // the ground truth's world and evaluated exactly as run() does. `frames` are the records of frames
+  // frame_index(0), frame_index(1), ... in order.
+  std::unique_ptr<System> make_system() const;
+  RunResult collect(System& system, std::vector<FrameRecord> frames, double wall_s = 0.0) const;
+
  private:
   PipelineOptions options_;
   std::unique_ptr<Sequence> sequence_;
