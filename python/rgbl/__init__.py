@@ -18,14 +18,4 @@ from . import _rgbl
 from ._rgbl import *  # noqa: F401,F403  (the extension is the API)
 from ._rgbl import __version__  # noqa: F401
 
-# help() and repr() name the package, not its extension.
-for _name in dir(_rgbl):
-    _value = getattr(_rgbl, _name)
-    if getattr(_value, "__module__", None) == "rgbl._rgbl":
-        try:
-            _value.__module__ = __name__
-        except (AttributeError, TypeError):
-            pass
-del _name, _value
-
 __all__ = [name for name in dir(_rgbl) if not name.startswith("_")]

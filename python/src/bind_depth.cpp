@@ -46,7 +46,7 @@ IpBasicOptions ip_basic_options(float max_depth, bool extrapolate, const std::st
 void bind_depth(py::module_& m) {
   m.def(
       "dilate_depth",
-      [](const py::handle& sparse, const std::string& kernel, int size, float max_depth) {
+      [](const ImageArg& sparse, const std::string& kernel, int size, float max_depth) {
         MatView keep;
         const cv::Mat_<float> in = depth_view(sparse, "sparse", keep);
         DilationOptions o;
@@ -67,7 +67,7 @@ void bind_depth(py::module_& m) {
       "in (0, max_depth).");
   m.def(
       "ip_basic",
-      [](const py::handle& sparse, const std::string& mode, float max_depth, bool extrapolate, const std::string& blur) {
+      [](const ImageArg& sparse, const std::string& mode, float max_depth, bool extrapolate, const std::string& blur) {
         MatView keep;
         const cv::Mat_<float> in = depth_view(sparse, "sparse", keep);
         const IpBasicOptions o = ip_basic_options(max_depth, extrapolate, blur);
@@ -83,7 +83,7 @@ void bind_depth(py::module_& m) {
       py::arg("blur") = "bilateral",
       "IP-Basic depth completion (Ku et al. 2018), 'fast' or 'multiscale'. float32 H x W in and out.");
   m.def(
-      "depth_density", [](const py::handle& depth) {
+      "depth_density", [](const ImageArg& depth) {
         MatView keep;
         return depth_density(depth_view(depth, "depth", keep));
       },
@@ -107,8 +107,8 @@ void bind_depth(py::module_& m) {
       .def_property_readonly("name", [](const PyDepthSource& s) { return std::string(s.source->name()); })
       .def(
           "prepare",
-          [](PyDepthSource& s, const py::handle& image, const py::handle& scan, const py::handle& image_right,
-             const py::handle& depth_image, std::size_t index, double timestamp) {
+          [](PyDepthSource& s, const ImageArg& image, const OptionalScanArg& scan, const OptionalImageArg& image_right,
+             const OptionalImageArg& depth_image, std::size_t index, double timestamp) {
             const MatView left = mat_view(image, "image");
             const MatView right = optional_mat_view(image_right, "image_right");
             const MatView depth = optional_mat_view(depth_image, "depth_image");
@@ -162,7 +162,7 @@ void bind_depth(py::module_& m) {
         py::arg("file"), "A depth PNG (uint16, depth x 256) in metres, float32 H x W.");
   m.def(
       "write_depth_png",
-      [](const std::filesystem::path& file, const py::handle& depth) {
+      [](const std::filesystem::path& file, const ImageArg& depth) {
         MatView keep;
         write_depth_png(file, depth_view(depth, "depth", keep));
       },
@@ -181,7 +181,7 @@ void bind_depth(py::module_& m) {
       });
   m.def(
       "evaluate_depth",
-      [](const py::handle& prediction, const py::handle& ground_truth) {
+      [](const ImageArg& prediction, const ImageArg& ground_truth) {
         MatView keep_p, keep_g;
         return evaluate_depth(depth_view(prediction, "prediction", keep_p), depth_view(ground_truth, "ground_truth", keep_g));
       },
@@ -190,7 +190,7 @@ void bind_depth(py::module_& m) {
       .def(py::init<>())
       .def(
           "add",
-          [](DepthErrorAccumulator& a, const py::handle& prediction, const py::handle& ground_truth) {
+          [](DepthErrorAccumulator& a, const ImageArg& prediction, const ImageArg& ground_truth) {
             MatView keep_p, keep_g;
             a.add(depth_view(prediction, "prediction", keep_p), depth_view(ground_truth, "ground_truth", keep_g));
           },

@@ -86,7 +86,7 @@ void bind_eval(py::module_& m) {
 
   m.def(
       "absolute_trajectory_error",
-      [](const py::handle& estimate, const py::handle& ground_truth, bool align) {
+      [](const PosesArg& estimate, const PosesArg& ground_truth, bool align) {
         const PosePair p(estimate, ground_truth);
         return absolute_trajectory_error(p.estimate.poses, p.ground_truth.poses, align);
       },
@@ -94,21 +94,21 @@ void bind_eval(py::module_& m) {
       "ATE: RMSE of positions after aligning the estimate to the ground truth (align=False: as given).");
   m.def(
       "relative_pose_error",
-      [](const py::handle& estimate, const py::handle& ground_truth, std::size_t delta) {
+      [](const PosesArg& estimate, const PosesArg& ground_truth, std::size_t delta) {
         const PosePair p(estimate, ground_truth);
         return relative_pose_error(p.estimate.poses, p.ground_truth.poses, delta);
       },
       py::arg("estimate"), py::arg("ground_truth"), py::arg("delta") = 1);
   m.def(
       "end_point_drift",
-      [](const py::handle& estimate, const py::handle& ground_truth) {
+      [](const PosesArg& estimate, const PosesArg& ground_truth) {
         const PosePair p(estimate, ground_truth);
         return end_point_drift(p.estimate.poses, p.ground_truth.poses);
       },
       py::arg("estimate"), py::arg("ground_truth"));
   m.def(
       "kitti_metric",
-      [](const py::handle& estimate, const py::handle& ground_truth, const std::optional<std::vector<double>>& lengths,
+      [](const PosesArg& estimate, const PosesArg& ground_truth, const std::optional<std::vector<double>>& lengths,
          std::size_t step_size) {
         const PosePair p(estimate, ground_truth);
         KittiMetricOptions o;
@@ -121,7 +121,7 @@ void bind_eval(py::module_& m) {
       "The KITTI devkit metric over segments of `lengths` metres (None: KITTI's 100..800 m).");
   m.def(
       "evaluate_trajectory",
-      [](const py::handle& estimate, const py::handle& ground_truth) {
+      [](const PosesArg& estimate, const PosesArg& ground_truth) {
         const PosePair p(estimate, ground_truth);
         return evaluate_trajectory(p.estimate.poses, p.ground_truth.poses);
       },
@@ -129,7 +129,7 @@ void bind_eval(py::module_& m) {
       "ATE, RPE, drift and the KITTI metric (with lengths that suit the path) at once; needs >= 2 poses.");
   m.def(
       "trajectory_distances",
-      [](const py::handle& poses) { return doubles_array(trajectory_distances(poses_view(poses, "poses").poses)); },
+      [](const PosesArg& poses) { return doubles_array(trajectory_distances(poses_view(poses, "poses").poses)); },
       py::arg("poses"), "Cumulative path length of the positions, starting at 0.");
 }
 

@@ -55,7 +55,7 @@ void bind_features(py::module_& m) {
       .def_property_readonly("options", [](const PyOrbExtractor& e) { return e.extractor->options(); })
       .def(
           "extract",
-          [](PyOrbExtractor& e, const py::handle& image) {
+          [](PyOrbExtractor& e, const ImageArg& image) {
             const MatView gray = mat_view(image, "image");
             if (gray.mat.type() != CV_8UC1) throw py::type_error("image: expected a uint8 H x W grey image");
             std::vector<Keypoint> keypoints;

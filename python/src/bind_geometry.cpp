@@ -146,7 +146,7 @@ void bind_geometry(py::module_& m) {
 
   m.def(
       "project_to_depth",
-      [](const py::handle& scan, const CameraCalibration& calibration, float min_depth, float max_depth) {
+      [](const ScanArg& scan, const CameraCalibration& calibration, float min_depth, float max_depth) {
         const ScanView points = scan_view(scan, "scan");
         ProjectionOptions options;
         options.min_depth = min_depth;
@@ -165,7 +165,7 @@ void bind_geometry(py::module_& m) {
       "LiDAR frame) in a camera: z-buffered, nearest point wins, min_depth < z < max_depth.");
   m.def(
       "project_to_depth",
-      [](const py::handle& scan, const py::handle& P_img_lidar, int width, int height, float min_depth,
+      [](const ScanArg& scan, const py::array_t<double>& P_img_lidar, int width, int height, float min_depth,
          float max_depth) {
         const ScanView points = scan_view(scan, "scan");
         ProjectionOptions options;

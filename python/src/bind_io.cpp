@@ -26,7 +26,7 @@ void bind_io(py::module_& m) {
   py::class_<Trajectory>(m, "Trajectory",
                          "Poses (float64 N x 4 x 4, T_world_cam) with their timestamps (float64 N, seconds; may "
                          "be empty for KITTI files). The arrays share the object's memory.")
-      .def(py::init([](const py::handle& poses, const py::object& timestamps) {
+      .def(py::init([](const PosesArg& poses, const py::object& timestamps) {
              Trajectory t;
              const PosesView view = poses_view(poses, "poses");
              t.poses.assign(view.poses.begin(), view.poses.end());
@@ -50,7 +50,7 @@ void bind_io(py::module_& m) {
         py::arg("file"), "A KITTI trajectory file (12 numbers per line) as float64 N x 4 x 4.");
   m.def(
       "write_kitti_trajectory",
-      [](const std::filesystem::path& file, const py::handle& poses) {
+      [](const std::filesystem::path& file, const PosesArg& poses) {
         write_kitti_trajectory(file, poses_view(poses, "poses").poses);
       },
       py::arg("file"), py::arg("poses"),

@@ -52,6 +52,7 @@ void bind_pipeline(py::module_& m) {
                         "camera). Arrays share the result's memory.")
       .def_readonly("sequence_name", &RunResult::sequence_name)
       .def_readonly("sequence_path", &RunResult::sequence_path)
+      .def_readonly("format", &RunResult::format)
       .def_readonly("camera", &RunResult::camera)
       .def_readonly("depth", &RunResult::depth)
       .def_readonly("first", &RunResult::first)

@@ -22,8 +22,8 @@ struct SystemTrajectory {
   Trajectory trajectory;
 };
 
-TrackResult track(System& system, const py::handle& image, const py::handle& scan, std::optional<std::size_t> index,
-                  std::optional<double> timestamp, const py::handle& image_right, const py::handle& depth_image,
+TrackResult track(System& system, const ImageArg& image, const OptionalScanArg& scan, std::optional<std::size_t> index,
+                  std::optional<double> timestamp, const OptionalImageArg& image_right, const OptionalImageArg& depth_image,
                   std::size_t tracked, double frame_period) {
   const MatView left = mat_view(image, "image");
   const MatView right = optional_mat_view(image_right, "image_right");
@@ -148,8 +148,8 @@ void bind_tracking(py::module_& m) {
            "default, is bit-for-bit reproducible).")
       .def(
           "track",
-          [](PySystem& s, const py::handle& image, const py::handle& scan, std::optional<std::size_t> index,
-             std::optional<double> timestamp, const py::handle& image_right, const py::handle& depth_image) {
+          [](PySystem& s, const ImageArg& image, const OptionalScanArg& scan, std::optional<std::size_t> index,
+             std::optional<double> timestamp, const OptionalImageArg& image_right, const OptionalImageArg& depth_image) {
             TrackResult r = track(*s.system, image, scan, index, timestamp, image_right, depth_image, s.tracked,
                                   s.frame_period);
             ++s.tracked;
@@ -183,12 +183,12 @@ void bind_tracking(py::module_& m) {
       .def_property_readonly("keyframe_count", [](const PySystem& s) {
         const std::shared_lock lock(s.system->map().mutex());
         return s.system->map().keyframe_count();
-      })
+      }, "Keyframes in the map now.")
       .def_property_readonly("landmark_count", [](const PySystem& s) {
         const std::shared_lock lock(s.system->map().mutex());
         return s.system->map().landmark_count();
-      })
-      .def_readonly("frames_tracked", &PySystem::tracked);
+      }, "Landmarks in the map now.")
+      .def_readonly("frames_tracked", &PySystem::tracked, "Calls of track() so far.");
 }
 
 }  // namespace rgbl::python

@@ -13,6 +13,7 @@
 #include "rgbl/geometry/point_cloud.hpp"
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -23,6 +24,13 @@ class System;
 namespace rgbl::python {
 
 namespace py = pybind11;
+
+// Parameter types, as help() and the signatures show them: ndarrays (lists are converted for scans and poses).
+using ImageArg = py::array;
+using OptionalImageArg = std::optional<py::array>;
+using ScanArg = py::array_t<float>;
+using OptionalScanArg = std::optional<py::array_t<float>>;
+using PosesArg = py::array_t<double>;
 
 // --- numpy in -------------------------------------------------------------------------------------
 // Arrays from Python are viewed in place when their layout allows; otherwise a packed copy is made
@@ -36,7 +44,7 @@ struct MatView {
 };
 MatView mat_view(const py::handle& object, const char* name);
 // The same for an optional argument (None -> an empty Mat).
-MatView optional_mat_view(const py::handle& object, const char* name);
+MatView optional_mat_view(const OptionalImageArg& array, const char* name);
 
 // LiDAR scans: float32 N x 4 (x, y, z, reflectance), the KITTI .bin layout LidarPoint has.
 struct ScanView {
@@ -44,6 +52,7 @@ struct ScanView {
   py::array array;
 };
 ScanView scan_view(const py::handle& object, const char* name);
+ScanView scan_view(const OptionalScanArg& array, const char* name);  // None -> no points
 
 // Poses: float64 N x 4 x 4 (T[i] a 4 x 4 matrix). Viewed in place when the array has Eigen's layout
 // (the column-major views this module returns do), else copied.

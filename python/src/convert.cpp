@@ -66,9 +66,9 @@ MatView mat_view(const py::handle& object, const char* name) {
   return view;
 }
 
-MatView optional_mat_view(const py::handle& object, const char* name) {
-  if (object.is_none()) return {};
-  return mat_view(object, name);
+MatView optional_mat_view(const OptionalImageArg& array, const char* name) {
+  if (!array) return {};
+  return mat_view(*array, name);
 }
 
 ScanView scan_view(const py::handle& object, const char* name) {
@@ -79,6 +79,11 @@ ScanView scan_view(const py::handle& object, const char* name) {
   view.points = PointCloudView(reinterpret_cast<const LidarPoint*>(a.data()), static_cast<std::size_t>(a.shape(0)));
   view.array = std::move(a);
   return view;
+}
+
+ScanView scan_view(const OptionalScanArg& array, const char* name) {
+  if (!array) return {};
+  return scan_view(*array, name);
 }
 
 PosesView poses_view(const py::handle& object, const char* name) {

@@ -66,6 +66,9 @@ void bind_errors(py::module_& m) {
 PYBIND11_MODULE(_rgbl, m) {
   namespace rp = rgbl::python;
   m.doc() = "rgbl: LiDAR-enhanced indirect visual SLAM (the C++ library's pipeline, numpy in and out).";
+  // Types and functions take the module's name as theirs: the package's, so that help() and the
+  // signatures say rgbl.System, not rgbl._rgbl.System. Restored below for the import system.
+  m.attr("__name__") = "rgbl";
   m.attr("__version__") = RGBL_VERSION_STRING;
   rp::bind_errors(m);
   rp::bind_geometry(m);
@@ -76,4 +79,5 @@ PYBIND11_MODULE(_rgbl, m) {
   rp::bind_tracking(m);
   rp::bind_pipeline(m);
   rp::bind_sim(m);
+  m.attr("__name__") = "rgbl._rgbl";
 }
