@@ -14,6 +14,11 @@ Errors arrive as rgbl.ConfigError (a ValueError: a bad option, `key` names it) a
 (an OSError: a missing or malformed file, `file` and `line` say where), both rgbl.Error.
 """
 
+try:
+    import numpy  # noqa: F401  (the extension needs it; say so plainly rather than "initialization failed")
+except ImportError as error:
+    raise ImportError(f"rgbl needs numpy, which this interpreter lacks (Debian: python3-numpy): {error}") from error
+
 from . import _rgbl
 from ._rgbl import *  # noqa: F401,F403  (the extension is the API)
 from ._rgbl import __version__  # noqa: F401
