@@ -13,7 +13,10 @@ packages=(
   libbenchmark-dev                            # Google Benchmark 1.7
   libcli11-dev                                # CLI11
   nlohmann-json3-dev                          # JSON (summary.json, the accuracy suite's table)
+  pybind11-dev python3-dev python3-numpy      # the Python module (python/)
+  python3-pytest                              # its tests
 )
+# matplotlib is only for examples/python (python3-matplotlib), never needed to build or test
 # fuzzing (scripts/fuzz.sh) needs clang with its libFuzzer/sanitizer runtimes
 if [ "${RGBL_FUZZ:-0}" = "1" ]; then
   packages+=(clang-14 libclang-rt-14-dev)

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README's test command: installs what is missing, builds with warnings as errors and runs every
-# test (unit, real-data when ../shared/data or $RGBL_DATA_DIR is there, and the find_package consumer).
+# test (unit, real-data when ../shared/data or $RGBL_DATA_DIR is there, the find_package consumer and the
+# Python module's pytest suite).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh

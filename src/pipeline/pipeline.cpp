@@ -151,12 +151,7 @@ Pipeline::Pipeline(const PipelineOptions& options, const DepthSourceRegistry& re
 
 std::unique_ptr<DepthSource> Pipeline::make_depth_source() const { return registry_.create(options_.depth, context_); }
 
-FeatureExtractor Pipeline::make_extractor() const {
-  auto extractor = std::make_shared<OrbExtractor>(orb_);
-  return [extractor](const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors) {
-    extractor->extract(gray, keypoints, descriptors);
-  };
-}
+FeatureExtractor Pipeline::make_extractor() const { return make_orb_extractor(orb_); }
 
 ReadAheadOptions Pipeline::read_ahead_options() const {
   ReadAheadOptions read;
@@ -177,8 +172,40 @@ SensorFrame Pipeline::sensor_frame(const FrameInput& input) const {
   return frame;
 }
 
+std::unique_ptr<System> Pipeline::make_system() const {
+  return std::make_unique<System>(system_, context_.calibration, make_depth_source(), make_extractor());
+}
+
 RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
-  System system(system_, context_.calibration, make_depth_source(), make_extractor());
+  const std::unique_ptr<System> system = make_system();
+  ReadAhead frames(*sequence_, read_ahead_options());
+  std::vector<FrameRecord> records;
+  records.reserve(count_);
+  Stopwatch wall;
+  bool stopped = false;
+  for (;;) {
+    if (stop.stop_requested()) {
+      stopped = records.size() < count_;
+      break;
+    }
+    Stopwatch wait;
+    std::optional<FrameInput> input = frames.next();
+    const double wait_ms = wait.elapsed_ms();
+    if (!input) break;
+    FrameRecord record;
+    record.result = system->track(sensor_frame(*input));
+    record.io_wait_ms = wait_ms;
+    records.push_back(record);
+    if (progress) progress(records.back(), records.size(), count_);
+  }
+  system->finish();
+  RunResult out = collect(*system, std::move(records), wall.elapsed_ms() / 1000.0);
+  out.stopped = stopped;
+  return out;
+}
+
+RunResult Pipeline::collect(System& system, std::vector<FrameRecord> frames, double wall_s) const {
+  system.finish();  // no-op when run() has already waited
   RunResult out;
   out.sequence_name = sequence_->name();
   out.sequence_path = sequence_->path();
@@ -188,28 +215,9 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
   out.first = options_.first;
   out.step = options_.step;
   out.threaded = system_.threaded_mapping;
-
-  ReadAhead frames(*sequence_, read_ahead_options());
-  out.frames.reserve(count_);
+  out.frames = std::move(frames);
   out.frames_planned = count_;
-  Stopwatch wall;
-  for (;;) {
-    if (stop.stop_requested()) {
-      out.stopped = out.frames.size() < count_;
-      break;
-    }
-    Stopwatch wait;
-    std::optional<FrameInput> input = frames.next();
-    const double wait_ms = wait.elapsed_ms();
-    if (!input) break;
-    FrameRecord record;
-    record.result = system.track(sensor_frame(*input));
-    record.io_wait_ms = wait_ms;
-    out.frames.push_back(record);
-    if (progress) progress(out.frames.back(), out.frames.size(), count_);
-  }
-  system.finish();
-  out.wall_s = wall.elapsed_ms() / 1000.0;
+  out.wall_s = wall_s;
   out.loop_closing = system.loop_closing();
   out.loop_closures = system.loop_closures();  // threaded: some came after the last frame
   out.loop_statistics = system.loop_statistics();

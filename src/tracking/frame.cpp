@@ -4,9 +4,17 @@
 #include "rgbl/tracking/options.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <cmath>
 
 namespace rgbl {
+
+FeatureExtractor make_orb_extractor(const OrbOptions& options) {
+  auto extractor = std::make_shared<OrbExtractor>(options);
+  return [extractor](const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors) {
+    extractor->extract(gray, keypoints, descriptors);
+  };
+}
 
 
 void TrackerOptions::validate() const {

@@ -224,12 +224,17 @@ TrackResult System::track(const SensorFrame& sensor) {
   s.depth->prepare(sensor);
   result.timing.depth_ms = stage.lap_ms();
 
-  if (sensor.image.channels() == 3) cv::cvtColor(sensor.image, s.gray, cv::COLOR_BGR2GRAY);
-  else s.gray = sensor.image;
+  // A grey input is used in place, never kept in s.gray: a later colour frame of the same size would
+  // be converted into the caller's (by then perhaps freed) buffer.
+  const cv::Mat* gray = &sensor.image;
+  if (sensor.image.channels() == 3) {
+    cv::cvtColor(sensor.image, s.gray, cv::COLOR_BGR2GRAY);
+    gray = &s.gray;
+  }
   Frame frame;
   frame.index = sensor.index;
   frame.timestamp = sensor.timestamp;
-  s.extractor(s.gray, frame.keypoints, frame.descriptors);
+  s.extractor(*gray, frame.keypoints, frame.descriptors);
   result.timing.extraction_ms = stage.lap_ms();
 
   const std::size_t n = frame.keypoints.size();

@@ -156,6 +156,13 @@ class Pipeline {
   // the run before the next frame: the result then holds what was tracked, with stopped set.
   RunResult run(const Progress& progress = {}, std::stop_token stop = {}) const;
 
+  // run() in parts, for a caller that feeds the frames itself (the Python module): the System run()
+  // tracks with, and the RunResult of the frames it tracked (after system.finish()), re-expressed in
+  // the ground truth's world and evaluated exactly as run() does. `frames` are the records of frames
+  // frame_index(0), frame_index(1), ... in order.
+  std::unique_ptr<System> make_system() const;
+  RunResult collect(System& system, std::vector<FrameRecord> frames, double wall_s = 0.0) const;
+
  private:
   PipelineOptions options_;
   std::unique_ptr<Sequence> sequence_;

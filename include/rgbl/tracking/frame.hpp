@@ -2,6 +2,7 @@
 // One tracked frame: keypoints, descriptors, depth per keypoint and a grid for radius queries.
 
 #include "rgbl/features/matcher.hpp"
+#include "rgbl/features/orb.hpp"
 #include "rgbl/features/types.hpp"
 #include "rgbl/map/map.hpp"
 
@@ -20,6 +21,9 @@ namespace rgbl {
 // extractor (rgbl's ORB, OpenCV's, a user's) can be injected.
 using FeatureExtractor =
     std::function<void(const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors)>;
+
+// rgbl's ORB extractor (rgbl/features/orb.hpp) as a FeatureExtractor; copies share one extractor.
+FeatureExtractor make_orb_extractor(const OrbOptions& options);
 
 struct Frame {
   std::size_t index = 0;
