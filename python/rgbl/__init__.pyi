@@ -389,7 +389,9 @@ class RunTimings:
 
 class RunMetrics:
     frames_with_ground_truth: int
+    frames_tracked: int
     evaluation: TrajectoryEvaluation
+    tracked_ate: Optional[AteResult]
     kitti_lengths: str
 
 class RunResult:
@@ -414,7 +416,10 @@ class RunResult:
     def landmarks(self) -> _F64: ...  # N x 3
     @property
     def keyframes(self) -> _F64: ...  # N x 4 x 4
+    frames_planned: int
+    stopped: bool
     def count(self, state: TrackState) -> int: ...
+    def tracked_count(self) -> int: ...
     def keyframe_count(self) -> int: ...
     def timings(self) -> RunTimings: ...
     def summary_json(self) -> str: ...

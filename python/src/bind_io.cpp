@@ -55,7 +55,7 @@ void bind_io(py::module_& m) {
       },
       py::arg("file"), py::arg("poses"),
       "Writes N x 4 x 4 poses as a KITTI trajectory (shortest round-trip numbers; written whole, then renamed).");
-  m.def("read_tum_trajectory", &read_tum_trajectory, py::arg("file"), "A TUM trajectory (t tx ty tz qx qy qz qw).");
+  m.def("read_tum_trajectory", [](const std::filesystem::path& file) { return read_tum_trajectory(file); }, py::arg("file"), "A TUM trajectory (t tx ty tz qx qy qz qw).");
   m.def("write_tum_trajectory", &write_tum_trajectory, py::arg("file"), py::arg("trajectory"));
   m.def("read_kitti_scan", [](const std::filesystem::path& file) { return scan_array(read_kitti_scan(file)); },
         py::arg("file"), "A KITTI velodyne .bin as float32 N x 4 (x, y, z, reflectance).");

@@ -44,7 +44,10 @@ void bind_pipeline(py::module_& m) {
 
   py::class_<RunMetrics>(m, "RunMetrics", "Accuracy against the ground truth over the frames it covers.")
       .def_readonly("frames_with_ground_truth", &RunMetrics::frames_with_ground_truth)
-      .def_readonly("evaluation", &RunMetrics::evaluation)
+      .def_readonly("frames_tracked", &RunMetrics::frames_tracked, "Of those, frames tracked (ok or weak).")
+      .def_readonly("evaluation", &RunMetrics::evaluation, "Over every frame (untracked ones at their guessed pose).")
+      .def_readonly("tracked_ate", &RunMetrics::tracked_ate,
+                    "AteResult over the tracked frames alone, or None with fewer than 2.")
       .def_readonly("kitti_lengths", &RunMetrics::kitti_lengths);
 
   py::class_<RunResult>(m, "RunResult",
@@ -75,15 +78,22 @@ void bind_pipeline(py::module_& m) {
       }, "float64 N x 4 x 4: T_world_cam0 of every keyframe.")
       .def_readonly("wall_s", &RunResult::wall_s)
       .def_readonly("metrics", &RunResult::metrics, "RunMetrics, or None without >= 2 frames of ground truth.")
+      .def_readonly("frames_planned", &RunResult::frames_planned)
+      .def_readonly("stopped", &RunResult::stopped, "Stopped on request before the last frame: every output is partial.")
       .def("count", &RunResult::count, py::arg("state"), "Frames in a TrackState.")
+      .def("tracked_count", &RunResult::tracked_count, "Frames with a tracked pose (ok or weak).")
       .def("keyframe_count", &RunResult::keyframe_count)
       .def("timings", &RunResult::timings)
       .def("summary_json", &summary_json, "summary.json's content.")
-      .def("write_outputs", &write_run_outputs, py::arg("out_dir"),
+      .def("write_outputs",
+           [](const RunResult& r, const std::filesystem::path& out_dir) { write_run_outputs(r, out_dir); },
+           py::arg("out_dir"),
            "Writes what `rgbl run` writes: trajectory_kitti.txt, trajectory_tum.txt, ground_truth_kitti.txt, "
            "timing.csv, summary.json, trajectory.svg, map.ply.");
 
-  m.def("write_run_outputs", &write_run_outputs, py::arg("result"), py::arg("out_dir"),
+  m.def("write_run_outputs",
+        [](const RunResult& r, const std::filesystem::path& out_dir) { write_run_outputs(r, out_dir); },
+        py::arg("result"), py::arg("out_dir"),
         "The same as RunResult.write_outputs(out_dir).");
   m.def("run_output_files", &run_output_files, "The files write_run_outputs() writes.");
 
