@@ -5,15 +5,39 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <opencv2/core.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <memory>
 #include <vector>
 
+namespace {
+
+// Last resort for an exception no handler can catch (one escaping a thread, or thrown while another
+// unwinds): the same one `error:` line and exit 1 as main's handlers, not an abort signal.
+[[noreturn]] void report_uncaught() {
+  try {
+    if (const auto error = std::current_exception()) std::rethrow_exception(error);
+    std::fputs("error: internal failure (std::terminate)\n", stderr);
+  } catch (const cv::Exception& e) {
+    fmt::print(stderr, "error: OpenCV failed in {}: {} (an input rgbl does not check yet; please report it)\n",
+               e.func, e.err);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+  } catch (...) {
+    std::fputs("error: unknown failure\n", stderr);
+  }
+  std::_Exit(1);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  std::set_terminate(report_uncaught);
   CLI::App app{"rgbl: LiDAR-enhanced visual SLAM (RGB-L) on KITTI and TUM data, and trajectory evaluation."};
   app.require_subcommand(1, 1);
   app.footer("Run `rgbl <command> --help` for a command's options.");
@@ -50,6 +74,11 @@ int main(int argc, char** argv) {
     }
     std::fputs("error: no command given (see rgbl --help)\n", stderr);
     return 2;
+  } catch (const cv::Exception& e) {
+    // an input rgbl's checks missed: say so in one line rather than OpenCV's multi-part message
+    fmt::print(stderr, "error: OpenCV failed in {}: {} (an input rgbl does not check yet; please report it)\n",
+               e.func, e.err);
+    return 1;
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return 1;
