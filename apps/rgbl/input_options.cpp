@@ -1,5 +1,7 @@
 #include "input_options.hpp"
 
+#include "command.hpp"
+
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/timer.hpp"
 
@@ -83,10 +85,10 @@ void add_input_options(CLI::App& app, PipelineOptions& options) {
                  "precomputed:<dir>, stereo (SGBM), stereo_sparse (keypoints only), rgbd")
       ->capture_default_str();
   app.add_option("--config", options.settings, "Settings YAML (ORB-SLAM style; RGB-L LiDAR.* keys accepted)");
-  app.add_option("--frames", options.frames, "Number of frames to process (default: all)");
-  app.add_option("--first", options.first, "First frame to process");
-  app.add_option("--step", options.step, "Process every N-th frame (e.g. 2: KITTI at 5 Hz)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--frames", options.frames, "Number of frames to process, >= 1 (default: all)")
+      ->check(whole_number(1));
+  app.add_option("--first", options.first, "First frame to process (0: the first)")->check(whole_number(0));
+  app.add_option("--step", options.step, "Process every N-th frame (e.g. 2: KITTI at 5 Hz)")->check(whole_number(1));
 }
 
 RunResult run_and_report(const Pipeline& pipeline, const OutputFolder& out_dir, bool quiet,

@@ -6,18 +6,37 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <opencv2/core.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <memory>
 #include <vector>
 
 namespace {
+
+// Last resort for an exception no handler can catch (one escaping a thread, or thrown while another
+// unwinds): the same one `error:` line and exit 1 as main's handlers, not an abort signal.
+[[noreturn]] void report_uncaught() {
+  try {
+    if (const auto error = std::current_exception()) std::rethrow_exception(error);
+    std::fputs("error: internal failure (std::terminate)\n", stderr);
+  } catch (const cv::Exception& e) {
+    fmt::print(stderr, "error: OpenCV failed in {}: {} (an input rgbl does not check yet; please report it)\n",
+               e.func, e.err);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+  } catch (...) {
+    std::fputs("error: unknown failure\n", stderr);
+  }
+  std::_Exit(1);
+}
 
 // Everything printed to stdout must have arrived: a full disk or a closed pipe is a failure, not a
 // success with a truncated report. Returns the exit code.
@@ -71,6 +90,11 @@ int run(int argc, char** argv) {
   } catch (const rgbl::cli::Interrupted& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return e.exit_code();
+  } catch (const cv::Exception& e) {
+    // an input rgbl's checks missed: say so in one line rather than OpenCV's multi-part message
+    fmt::print(stderr, "error: OpenCV failed in {}: {} (an input rgbl does not check yet; please report it)\n",
+               e.func, e.err);
+    return 1;
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return 1;
@@ -83,6 +107,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::set_terminate(report_uncaught);
   // a closed pipe on stdout (or a FIFO's reader gone) is an EPIPE error to report, not a silent death
   std::signal(SIGPIPE, SIG_IGN);
   const int code = run(argc, argv);

@@ -52,14 +52,14 @@ Command add_vocab_command(CLI::App& parent) {
       ->check(CLI::Range(1, 8));
   train_app->add_option("--iterations", args->options.vocabulary.iterations, "k-medians rounds per node")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(1));
   train_app->add_option("--seed", args->options.vocabulary.seed, "Seed of the k-means++ initialisation")->capture_default_str();
   train_app->add_option("--features", args->options.orb.num_features, "ORB features per image")
       ->capture_default_str()
       ->check(CLI::Range(1, 100000));
   train_app->add_option("--every", args->options.every, "Use every N-th image of each folder")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(1));
   return {app, [args, train_app] { return train_app->parsed() ? train(*args) : 2; }};
 }
 

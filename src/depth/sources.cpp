@@ -1,6 +1,7 @@
 #include "rgbl/depth/sources.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 #include "source_checks.hpp"
 
 #include <fmt/format.h>
@@ -54,7 +55,7 @@ void RgbdSourceOptions::validate() const {
 }
 
 cv::Mat_<float> read_depth_png(const std::filesystem::path& file) {
-  if (!std::filesystem::exists(file)) throw ParseError(file, 0, "a depth PNG (uint16, depth x 256); the file does not exist");
+  require_image_file(file, "a depth PNG (uint16, depth x 256)");
   const cv::Mat raw = cv::imread(file.string(), cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
   if (raw.empty() || raw.type() != CV_16UC1) throw ParseError(file, 0, "a single-channel uint16 PNG (depth x 256)");
   cv::Mat_<float> depth;
@@ -217,6 +218,7 @@ class StereoDepthSource final : public DenseDepthSource {
       : camera_(context.calibration.camera), baseline_(context.stereo_baseline), options_(options) {
     options_.validate();
     detail::require_stereo_baseline(baseline_);
+    if (camera_.width > 0) require_width(camera_.width);
     const int area = options_.block_size * options_.block_size;
     matcher_ = cv::StereoSGBM::create(0, options_.num_disparities, options_.block_size, 8 * area, 32 * area, 1,
                                       0, options_.uniqueness_ratio, options_.speckle_window, options_.speckle_range,
@@ -231,6 +233,7 @@ class StereoDepthSource final : public DenseDepthSource {
     }
     detail::require_camera_size(frame.image, camera_, "frame.image");
     detail::require_camera_size(frame.image_right, camera_, "frame.image_right");
+    require_width(frame.image.cols);
     matcher_->compute(detail::grey_image(frame.image), detail::grey_image(frame.image_right), disparity_);
     depth_.create(disparity_.rows, disparity_.cols);
     const float fb = static_cast<float>(camera_.fx * baseline_);
@@ -246,6 +249,17 @@ class StereoDepthSource final : public DenseDepthSource {
   }
 
  private:
+  // SGBM searches num_disparities columns to the left of each pixel: narrower images fail inside OpenCV
+  // (an assertion, or an abort while it cleans up).
+  void require_width(int width) const {
+    if (width <= options_.num_disparities) {
+      throw ConfigError("--depth", fmt::format("stereo on images wider than its disparity range "
+                                               "(stereo.num_disparities = {} px), found images {} px wide; use "
+                                               "stereo_sparse or lidar",
+                                               options_.num_disparities, width));
+    }
+  }
+
   PinholeCamera camera_;
   double baseline_;
   StereoSourceOptions options_;

@@ -1,7 +1,9 @@
 #include "rgbl/geometry/calibration.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 
+#include <Eigen/LU>
 #include <fmt/format.h>
 
 #include <charconv>
@@ -57,6 +59,7 @@ KeyValueFile parse_key_value(std::istream& in, const std::filesystem::path& path
   std::size_t line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
+    if (line_no == 1 && line.starts_with("\xEF\xBB\xBF")) line.erase(0, 3);  // UTF-8 byte order mark
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.find_first_not_of(" \t") == std::string::npos) continue;
     const auto colon = line.find(':');
@@ -85,15 +88,17 @@ KeyValueFile parse_key_value(std::istream& in, const std::filesystem::path& path
       rest.remove_prefix(stop);
     }
     if (!numeric) entry.values.clear();
-    file.entries.insert_or_assign(std::move(key), std::move(entry));
+    if (const auto it = file.entries.find(key); it != file.entries.end()) {
+      throw ParseError(path, line_no, fmt::format("'{}' given twice (lines {} and {}); expected one line per key", key,
+                                                  it->second.line, line_no));
+    }
+    file.entries.emplace(std::move(key), std::move(entry));
   }
   return file;
 }
 
 std::ifstream open_calibration(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw ParseError(path, 0, "cannot open the file (expected a KITTI calibration file)");
-  return in;
+  return open_input_file(path, "a KITTI calibration file");
 }
 
 template <int Rows, int Cols>
@@ -104,10 +109,57 @@ Eigen::Matrix<double, Rows, Cols> row_major(const std::vector<double>& v) {
   return m;
 }
 
-void check_projection(const KeyValueFile& file, const std::string& key, const Matrix34d& P) {
+// A rectified projection K [I | t]: plausible intrinsics (see PinholeCamera::implausibility; the size
+// when known), no skew or rotation, and a camera within kMaxOffset of cam0.
+void check_projection(const KeyValueFile& file, const std::string& key, const Matrix34d& P, int width, int height) {
+  constexpr double kMaxOffset = 100.0;  // m: a rig, not a survey
+  const std::size_t line = file.entries.find(key)->second.line;
   if (!(P(0, 0) > 0.0 && P(1, 1) > 0.0 && P(2, 2) > 0.0)) {
-    throw ParseError(file.path, file.entries.find(key)->second.line,
+    throw ParseError(file.path, line,
                      fmt::format("expected '{}' to be a projection K[I|t] with positive focal lengths", key));
+  }
+  if (P(0, 1) != 0.0 || P(1, 0) != 0.0 || P(2, 0) != 0.0 || P(2, 1) != 0.0 || std::abs(P(2, 2) - 1.0) > 1e-9) {
+    throw ParseError(file.path, line,
+                     fmt::format("expected '{}' to be a rectified projection K[I|t]: 0 at (1,2), (2,1), (3,1), (3,2) "
+                                 "and 1 at (3,3)",
+                                 key));
+  }
+  PinholeCamera camera;
+  camera.fx = P(0, 0);
+  camera.fy = P(1, 1);
+  camera.cx = P(0, 2);
+  camera.cy = P(1, 2);
+  camera.width = width;
+  camera.height = height;
+  if (const auto why = camera.implausibility()) {
+    throw ParseError(file.path, line, fmt::format("'{}': {}", key, *why));
+  }
+  const Eigen::Vector3d t = P.leftCols<3>().inverse() * P.col(3);
+  if (!(t.norm() <= kMaxOffset)) {
+    throw ParseError(file.path, line,
+                     fmt::format("'{}' puts the camera {:g} m from cam0 (expected at most {} m)", key, t.norm(),
+                                 kMaxOffset));
+  }
+}
+
+// R must be a rotation (to 1e-4: KITTI's printed rotations are orthonormal to ~1e-7) and t a plausible
+// offset, or the calibration would move and scale every point.
+void check_rigid(const KeyValueFile& file, const std::string& key, const Eigen::Matrix3d& R,
+                 const Eigen::Vector3d& t = Eigen::Vector3d::Zero(), const std::string& t_key = {}) {
+  constexpr double kMaxOffset = 100.0;  // m
+  const std::size_t line = file.entries.find(key)->second.line;
+  const std::size_t t_line = t_key.empty() ? line : file.entries.find(t_key)->second.line;
+  const double error = rotation_error(R);
+  if (!(error <= 1e-4)) {
+    throw ParseError(file.path, line,
+                     fmt::format("expected '{}' to hold a rotation matrix (orthonormal, det +1), found R^T R - I or "
+                                 "det R - 1 off by {:.2g}",
+                                 key, error));
+  }
+  if (!(t.norm() <= kMaxOffset)) {
+    throw ParseError(file.path, t_line,
+                     fmt::format("expected '{}' to hold a translation of at most {} m, found {:g} m",
+                                 t_key.empty() ? key : t_key, kMaxOffset, t.norm()));
   }
 }
 
@@ -151,9 +203,11 @@ KittiCalibration parse_kitti_odometry_calibration(std::istream& in, const std::f
   for (int i = 0; i < 4; ++i) {
     const std::string key = fmt::format("P{}", i);
     calib.P[static_cast<std::size_t>(i)] = row_major<3, 4>(file.get(key, 12).values);
-    check_projection(file, key, calib.P[static_cast<std::size_t>(i)]);
+    check_projection(file, key, calib.P[static_cast<std::size_t>(i)], width, height);
   }
-  calib.T_cam0_lidar = isometry_from_3x4(row_major<3, 4>(file.get("Tr", 12).values));
+  const Matrix34d Tr = row_major<3, 4>(file.get("Tr", 12).values);
+  check_rigid(file, "Tr", Tr.leftCols<3>(), Tr.col(3));
+  calib.T_cam0_lidar = isometry_from_3x4(Tr);
   calib.width.fill(width);
   calib.height.fill(height);
   return calib;
@@ -176,7 +230,6 @@ KittiCalibration parse_kitti_raw_calibration(std::istream& cam_to_cam, const std
     const auto idx = static_cast<std::size_t>(i);
     const std::string p_key = fmt::format("P_rect_0{}", i);
     calib.P[idx] = row_major<3, 4>(cam.get(p_key, 12).values);
-    check_projection(cam, p_key, calib.P[idx]);
     const std::string s_key = fmt::format("S_rect_0{}", i);
     const auto& size = cam.get(s_key, 2);
     if (!(size.values[0] >= 1.0 && size.values[0] <= 1e5 && size.values[1] >= 1.0 && size.values[1] <= 1e5)) {
@@ -184,10 +237,13 @@ KittiCalibration parse_kitti_raw_calibration(std::istream& cam_to_cam, const std
     }
     calib.width[idx] = static_cast<int>(size.values[0]);
     calib.height[idx] = static_cast<int>(size.values[1]);
+    check_projection(cam, p_key, calib.P[idx], calib.width[idx], calib.height[idx]);
   }
   const Eigen::Matrix3d R_rect = row_major<3, 3>(cam.get("R_rect_00", 9).values);
+  check_rigid(cam, "R_rect_00", R_rect);
   const Eigen::Matrix3d R = row_major<3, 3>(velo.get("R", 9).values);
   const Eigen::Vector3d t = row_major<3, 1>(velo.get("T", 3).values);
+  check_rigid(velo, "R", R, t, "T");
   calib.T_cam0_lidar = make_isometry(R_rect, Eigen::Vector3d::Zero()) * make_isometry(R, t);
   return calib;
 }

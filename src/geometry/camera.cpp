@@ -3,12 +3,41 @@
 #include "rgbl/core/error.hpp"
 
 #include <Eigen/LU>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
 
 namespace rgbl {
 
 void PinholeCamera::validate() const {
   require(fx > 0.0 && fy > 0.0, "camera.fx/fy", "focal lengths > 0");
   require(width > 0 && height > 0, "camera.width/height", "an image size > 0");
+}
+
+std::optional<std::string> PinholeCamera::implausibility() const {
+  const double values[] = {fx, fy, cx, cy, distortion.k1, distortion.k2, distortion.p1, distortion.p2, distortion.k3};
+  for (const double v : values) {
+    if (!std::isfinite(v)) return "intrinsics and distortion must be finite numbers";
+  }
+  const auto focal = [](double f) { return fmt::format("{:g}", f); };
+  if (!(fx >= 1.0 && fx <= 1e6 && fy >= 1.0 && fy <= 1e6)) {
+    return fmt::format("focal lengths fx {} fy {} px are outside 1..1e6 px", focal(fx), focal(fy));
+  }
+  if (!(std::abs(cx) <= 1e6 && std::abs(cy) <= 1e6)) {
+    return fmt::format("principal point ({:g}, {:g}) px is outside +-1e6 px", cx, cy);
+  }
+  if (width <= 0 || height <= 0) return std::nullopt;
+  const double side = std::max(width, height);
+  if (!(fx >= 0.02 * side && fx <= 100.0 * side && fy >= 0.02 * side && fy <= 100.0 * side)) {
+    return fmt::format("focal lengths fx {} fy {} px are implausible for a {}x{} image (expected 0.02..100 times "
+                       "its larger side: fields of view of 0.6..175 degrees)",
+                       focal(fx), focal(fy), width, height);
+  }
+  if (!(cx >= -width && cx <= 2.0 * width && cy >= -height && cy <= 2.0 * height)) {
+    return fmt::format("principal point ({:g}, {:g}) px is far outside the {}x{} image", cx, cy, width, height);
+  }
+  return std::nullopt;
 }
 
 Eigen::Matrix3d PinholeCamera::K() const {

@@ -1,10 +1,13 @@
 #include "rgbl/geometry/point_cloud.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 
 #include <fmt/format.h>
 
 #include <fstream>
+#include <string_view>
+#include <system_error>
 
 namespace rgbl {
 
@@ -15,17 +18,23 @@ PointCloudView view_kitti_scan(std::span<const float> packed) {
 }
 
 void read_kitti_scan(const std::filesystem::path& path, std::vector<LidarPoint>& points) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw ParseError(path, 0, "cannot open the file (expected a KITTI velodyne .bin scan)");
-  const auto bytes = static_cast<std::size_t>(in.tellg());
+  constexpr std::string_view kWhat = "a KITTI velodyne .bin scan";
+  std::ifstream in = open_input_file(path, kWhat, true);
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (ec) throw ParseError(path, 0, fmt::format("cannot tell its size: {} (expected {})", ec.message(), kWhat));
   if (bytes % sizeof(LidarPoint) != 0) {
     throw ParseError(path, 0,
                      fmt::format("size {} bytes is not a multiple of 16 (expected float32 x, y, z, "
                                  "reflectance records; truncated download?)",
                                  bytes));
   }
+  if (bytes / sizeof(LidarPoint) > kMaxScanPoints) {
+    throw ParseError(path, 0,
+                     fmt::format("holds {} points, more than rgbl reads ({}; a KITTI scan has about 120000)",
+                                 bytes / sizeof(LidarPoint), kMaxScanPoints));
+  }
   points.resize(bytes / sizeof(LidarPoint));
-  in.seekg(0);
   if (!in.read(reinterpret_cast<char*>(points.data()), static_cast<std::streamsize>(bytes))) {  // NOLINT
     throw ParseError(path, 0, fmt::format("could not read {} bytes", bytes));
   }

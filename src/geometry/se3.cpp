@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace rgbl {
 namespace {
@@ -72,6 +73,12 @@ Eigen::Isometry3d interpolate(const Eigen::Isometry3d& T_a, const Eigen::Isometr
 double rotation_angle(const Eigen::Matrix3d& R) {
   // acos of the trace is imprecise near 0; the quaternion route is not.
   return so3_log(R).norm();
+}
+
+double rotation_error(const Eigen::Matrix3d& R) {
+  if (!R.allFinite()) return std::numeric_limits<double>::quiet_NaN();
+  return std::max((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(),
+                  std::abs(R.determinant() - 1.0));
 }
 
 Eigen::Isometry3d make_isometry(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {

@@ -1,6 +1,8 @@
 #include "file_sequence.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
+#include "rgbl/io/image.hpp"
 #include "rgbl/geometry/point_cloud.hpp"
 #include "text.hpp"
 
@@ -68,10 +70,7 @@ class FileSequence final : public Sequence {
   }
 
   cv::Mat_<float> read_depth(const std::filesystem::path& file) const {
-    const cv::Mat raw = cv::imread(file.string(), cv::IMREAD_ANYDEPTH);
-    if (raw.empty()) {
-      throw ParseError(file, 0, "cannot read or decode the depth image (missing, corrupt or truncated PNG?)");
-    }
+    const cv::Mat raw = read_image_file(file, cv::IMREAD_ANYDEPTH);
     if (raw.type() != CV_16UC1) throw ParseError(file, 0, "expected a 16-bit single-channel depth PNG");
     const int w = table_.calibration.width[2];
     const int h = table_.calibration.height[2];
@@ -96,15 +95,7 @@ std::unique_ptr<Sequence> make_file_sequence(SequenceTable table, const LoadOpti
 }
 
 cv::Mat read_image(const std::filesystem::path& file, bool grey) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) {
-    throw ParseError(file, 0, "missing (expected an image file)");
-  }
-  cv::Mat image = cv::imread(file.string(), grey ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
-  if (image.empty()) {
-    throw ParseError(file, 0, "cannot read or decode the image (corrupt or truncated PNG?)");
-  }
-  return image;
+  return read_image_file(file, grey ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
 }
 
 void set_image_sizes(SequenceTable& table) {
@@ -128,6 +119,13 @@ void set_image_sizes(SequenceTable& table) {
     table.calibration.width[0] = table.calibration.width[2];
     table.calibration.height[0] = table.calibration.height[2];
   }
+  // now that the sizes are known: intrinsics that fit them (odometry calib.txt carries no size)
+  for (std::size_t c = 0; c < 4; ++c) {
+    if (!table.sensors.cameras[c] || table.calibration_file.empty()) continue;
+    if (const auto why = table.calibration.camera(static_cast<int>(c)).camera.implausibility()) {
+      throw ParseError(table.calibration_file, 0, fmt::format("camera {}: {}", c, *why));
+    }
+  }
 }
 
 void require_frames(const std::filesystem::path& dir, std::size_t count, int digits, std::string_view extension) {
@@ -145,3 +143,20 @@ void require_frames(const std::filesystem::path& dir, std::size_t count, int dig
 }
 
 }  // namespace rgbl::detail
+
+namespace rgbl {
+
+cv::Mat read_image_file(const std::filesystem::path& file, int flags) {
+  constexpr std::string_view kWhat = "an image file";
+  require_image_file(file, kWhat);
+  cv::Mat image;
+  try {
+    image = cv::imread(file.string(), flags);
+  } catch (const cv::Exception& e) {  // e.g. OpenCV's own size limit
+    throw ParseError(file, 0, fmt::format("cannot read or decode the image (OpenCV: {})", e.err));
+  }
+  if (image.empty()) throw ParseError(file, 0, "cannot read or decode the image (corrupt or truncated PNG?)");
+  return image;
+}
+
+}  // namespace rgbl

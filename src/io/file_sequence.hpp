@@ -25,6 +25,9 @@ struct SequenceTable {
   std::string name;
   std::filesystem::path path;
   KittiCalibration calibration;
+  // the file of the intrinsics, checked against the image sizes; empty: not checked (TUM's are fixed
+  // published values or TumOptions', which validate() checks)
+  std::filesystem::path calibration_file;
   SensorSet sensors;
   std::vector<FrameFiles> frames;
   std::optional<Trajectory> ground_truth;
@@ -39,7 +42,8 @@ std::unique_ptr<Sequence> make_file_sequence(SequenceTable table, const LoadOpti
 cv::Mat read_image(const std::filesystem::path& file, bool grey);
 
 // Fills table.calibration's sizes for the cameras present from their first image; when the
-// calibration already has a size for a camera (raw), the first image must match it.
+// calibration already has a size for a camera (raw), the first image must match it. Then checks the
+// intrinsics against the sizes (PinholeCamera::implausibility), naming table.calibration_file.
 void set_image_sizes(SequenceTable& table);
 
 // Throws ParseError naming the first missing file of frames 0..count-1 in dir (name = zero-padded

@@ -1,6 +1,7 @@
 // KITTI odometry and raw loaders, and the format detection.
 #include "file_sequence.hpp"
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 #include "rgbl/core/log.hpp"
 #include "rgbl/geometry/se3.hpp"
 #include "rgbl/io/kitti_raw.hpp"
@@ -25,8 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path normalised_dir(const fs::path& dir, std::string_view expected) {
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw ParseError(dir, 0, fmt::format("not a folder (expected {})", expected));
+  require_input_folder(dir, expected);
   auto path = dir.lexically_normal();
   if (!path.has_filename()) path = path.parent_path();  // "seq/04/" -> "seq/04"
   return path;
@@ -43,22 +43,16 @@ std::size_t frame_count(const std::vector<fs::path>& dirs, std::string_view ext_
   return count;
 }
 
-std::vector<double> read_numbers_per_line(const fs::path& file, std::string_view what) {
-  auto in = detail::open_for_reading(file, what);
-  std::vector<double> values;
-  std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const auto tokens = detail::split(line);
-    if (tokens.empty()) continue;
-    double v = 0.0;
-    if (tokens.size() != 1 || !detail::parse_double(tokens[0], v) || !std::isfinite(v)) {
-      throw ParseError(file, line_no, fmt::format("expected {}", what));
-    }
-    values.push_back(v);
+// Frame times must order the frames: a repeated or earlier time would give a trajectory that no
+// evaluation (TUM's format, interpolation) accepts.
+void require_increasing(const fs::path& file, std::size_t line_no, double t, double previous,
+                        std::size_t previous_line) {
+  if (!(t > previous)) {
+    throw ParseError(file, line_no,
+                     fmt::format("timestamp {} is not after the one on line {} ({}); expected strictly increasing "
+                                 "times, one per frame",
+                                 t, previous_line, previous));
   }
-  return values;
 }
 
 // "2011-09-26 13:08:24.973999360" -> seconds since 1970-01-01 (the clock's own time zone).
@@ -102,15 +96,17 @@ double parse_raw_timestamp(std::string_view text, const fs::path& file, std::siz
   return days * 86400.0 + hour * 3600.0 + minute * 60.0 + second;
 }
 
-std::vector<double> read_raw_timestamps(const fs::path& file) {
+std::vector<double> read_raw_timestamps(const fs::path& file, bool strictly_increasing) {
   auto in = detail::open_for_reading(file, "KITTI raw timestamps, one per line");
   std::vector<double> values;
   std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
+  std::size_t line_no = 0, previous_line = 0;
+  while (detail::read_line(in, line, line_no)) {
     if (detail::split(line).empty()) continue;
-    values.push_back(parse_raw_timestamp(line, file, line_no));
+    const double t = parse_raw_timestamp(line, file, line_no);
+    if (strictly_increasing && !values.empty()) require_increasing(file, line_no, t, values.back(), previous_line);
+    values.push_back(t);
+    previous_line = line_no;
   }
   return values;
 }
@@ -124,6 +120,28 @@ void check_count(const fs::path& file, std::size_t rows, std::size_t frames, std
 
 }  // namespace
 
+std::vector<double> read_kitti_times(const fs::path& times_txt) {
+  constexpr std::string_view kWhat = "one timestamp (seconds) per line";
+  auto in = detail::open_for_reading(times_txt, kWhat);
+  std::vector<double> values;
+  std::string line;
+  std::size_t line_no = 0, previous_line = 0;
+  while (detail::read_line(in, line, line_no)) {
+    const auto tokens = detail::split(line);
+    if (tokens.empty()) continue;
+    double t = 0.0;
+    if (tokens.size() != 1 || !detail::parse_double(tokens[0], t) || !std::isfinite(t)) {
+      throw ParseError(times_txt, line_no, fmt::format("expected {}", kWhat));
+    }
+    if (!values.empty()) require_increasing(times_txt, line_no, t, values.back(), previous_line);
+    values.push_back(t);
+    previous_line = line_no;
+  }
+  return values;
+}
+
+std::vector<double> read_kitti_raw_timestamps(const fs::path& file) { return read_raw_timestamps(file, true); }
+
 std::unique_ptr<Sequence> open_kitti_odometry(const fs::path& sequence_dir, const LoadOptions& options) {
   const fs::path dir = normalised_dir(
       sequence_dir, "a KITTI odometry sequence folder with calib.txt, times.txt, image_0..3/, velodyne/");
@@ -132,6 +150,7 @@ std::unique_ptr<Sequence> open_kitti_odometry(const fs::path& sequence_dir, cons
   table.name = dir.filename().string();
   table.path = dir;
   table.calibration = read_kitti_odometry_calibration(dir / "calib.txt");
+  table.calibration_file = dir / "calib.txt";
 
   std::vector<fs::path> dirs;
   std::vector<bool> is_scan;
@@ -157,7 +176,7 @@ std::unique_ptr<Sequence> open_kitti_odometry(const fs::path& sequence_dir, cons
     detail::require_frames(dirs[k], count, 6, is_scan[k] ? ".bin" : ".png");
   }
   const auto times_file = dir / "times.txt";
-  const auto times = read_numbers_per_line(times_file, "one timestamp (seconds) per line");
+  const auto times = read_kitti_times(times_file);
   check_count(times_file, times.size(), count, "timestamps");
 
   table.frames.resize(count);
@@ -172,6 +191,7 @@ std::unique_ptr<Sequence> open_kitti_odometry(const fs::path& sequence_dir, cons
 
   const auto poses_file = dir.parent_path().parent_path() / "poses" / (table.name + ".txt");
   if (fs::exists(poses_file, ec)) {
+    require_input_file(poses_file, "a KITTI trajectory: 12 numbers per line");  // read_kitti_trajectory takes pipes
     auto poses = read_kitti_trajectory(poses_file);
     if (poses.size() < count) {
       throw ParseError(poses_file, 0,
@@ -197,8 +217,7 @@ OxtsPacket read_oxts_packet(const fs::path& file) {
   auto in = detail::open_for_reading(file, "an OXTS packet: 30 numbers on one line");
   std::string line;
   std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
+  while (detail::read_line(in, line, line_no)) {
     if (!detail::split(line).empty()) break;
   }
   const auto tokens = detail::split(line);
@@ -246,12 +265,17 @@ Eigen::Isometry3d read_kitti_rigid_transform(const fs::path& file) {
   std::optional<Eigen::Matrix3d> R;
   std::optional<Eigen::Vector3d> t;
   std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
+  std::size_t line_no = 0, R_line = 0, t_line = 0;
+  while (detail::read_line(in, line, line_no)) {
     const auto tokens = detail::split(line);
     if (tokens.empty() || (tokens[0] != "R:" && tokens[0] != "T:")) continue;
     const std::size_t n = tokens[0] == "R:" ? 9 : 3;
+    std::size_t& seen = n == 9 ? R_line : t_line;
+    if (seen != 0) {
+      throw ParseError(file, line_no, fmt::format("'{}' given twice (lines {} and {}); expected one line per key",
+                                                  tokens[0].substr(0, 1), seen, line_no));
+    }
+    seen = line_no;
     if (tokens.size() != n + 1) {
       throw ParseError(file, line_no, fmt::format("expected {} numbers after '{}'", n, tokens[0]));
     }
@@ -270,6 +294,17 @@ Eigen::Isometry3d read_kitti_rigid_transform(const fs::path& file) {
   }
   if (!R) throw ParseError(file, 0, "expected a line 'R: ' followed by 9 numbers");
   if (!t) throw ParseError(file, 0, "expected a line 'T: ' followed by 3 numbers");
+  // to 1e-4: the files' 7-digit rotations are orthonormal to ~1e-7
+  if (const double error = rotation_error(*R); !(error <= 1e-4)) {
+    throw ParseError(file, R_line,
+                     fmt::format("expected 'R' to hold a rotation matrix (orthonormal, det +1), found R^T R - I or "
+                                 "det R - 1 off by {:.2g}",
+                                 error));
+  }
+  if (!(t->norm() <= 100.0)) {
+    throw ParseError(file, t_line, fmt::format("expected 'T' to hold a translation of at most 100 m, found {:g} m",
+                                               t->norm()));
+  }
   return make_isometry(*R, *t);
 }
 
@@ -283,6 +318,7 @@ std::unique_ptr<Sequence> open_kitti_raw(const fs::path& drive_dir, const LoadOp
   table.name = dir.filename().string();
   table.path = dir;
   table.calibration = read_kitti_raw_calibration(date_dir);
+  table.calibration_file = date_dir / "calib_cam_to_cam.txt";
 
   std::vector<fs::path> dirs;
   std::vector<bool> is_scan;
@@ -309,7 +345,7 @@ std::unique_ptr<Sequence> open_kitti_raw(const fs::path& drive_dir, const LoadOp
   for (std::size_t k = 0; k < dirs.size(); ++k) {
     detail::require_frames(dirs[k], count, 10, is_scan[k] ? ".bin" : ".png");
   }
-  const auto times = read_raw_timestamps(time_source);
+  const auto times = read_kitti_raw_timestamps(time_source);
   check_count(time_source, times.size(), count, "timestamps");
 
   table.frames.resize(count);
@@ -350,7 +386,8 @@ std::unique_ptr<Sequence> open_kitti_raw(const fs::path& drive_dir, const LoadOp
       // packets (a 1.3 m step at 13 m/s moves 13 cm in 10 ms).
       const auto oxts_times_file = dir / "oxts" / "timestamps.txt";
       if (fs::exists(oxts_times_file, ec)) {
-        const auto oxts_times = read_raw_timestamps(oxts_times_file);
+        // the OXTS clock only places the packets: out of order falls back to packet by packet below
+        const auto oxts_times = read_raw_timestamps(oxts_times_file, false);
         check_count(oxts_times_file, oxts_times.size(), count, "timestamps");
         if (count >= 2 && std::is_sorted(oxts_times.begin(), oxts_times.end(), std::less_equal<>())) {
           for (std::size_t i = 0; i < count; ++i) {
@@ -406,10 +443,8 @@ std::string_view to_string(DatasetFormat format) {
 std::unique_ptr<Sequence> open_sequence(const fs::path& dir, DatasetFormat format, const LoadOptions& options) {
   if (format == DatasetFormat::automatic) {
     std::error_code ec;
-    if (!fs::is_directory(dir, ec)) {
-      throw ParseError(dir, 0,
-                       "not a folder (expected a KITTI odometry sequence, KITTI raw drive or TUM RGB-D folder)");
-    }
+    // an unreadable folder would look like one of an unknown format
+    require_input_folder(dir, "a KITTI odometry sequence, KITTI raw drive or TUM RGB-D folder");
     if (fs::exists(dir / "calib.txt", ec) && fs::exists(dir / "times.txt", ec)) {
       format = DatasetFormat::kitti;
     } else if (fs::is_directory(dir / "oxts", ec) || fs::is_directory(dir / "velodyne_points", ec) ||

@@ -3,6 +3,7 @@
 #include "text.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
@@ -13,10 +14,12 @@
 #include <exception>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <optional>
 #include <set>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 namespace rgbl {
 namespace {
@@ -122,17 +125,13 @@ void LoopClosingSettings::validate() const {
 }
 
 Settings read_settings(const std::filesystem::path& yaml) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(yaml, ec)) {
-    throw ParseError(yaml, 0, "missing or not a file (expected an ORB-SLAM style %YAML:1.0 settings file)");
-  }
   // OpenCV insists on a "%YAML:1.0" first line; plain YAML files get it added in memory.
   std::string text;
   {
-    std::ifstream in(yaml, std::ios::binary);
-    if (!in) throw ParseError(yaml, 0, "cannot open (expected an ORB-SLAM style %YAML:1.0 settings file)");
+    std::ifstream in = open_input_file(yaml, "an ORB-SLAM style %YAML:1.0 settings file", true);
     text.assign(std::istreambuf_iterator<char>(in), {});
   }
+  if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);  // UTF-8 byte order mark
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
     throw ParseError(yaml, 0, "is empty (expected 'Key: value' settings)");
   }
@@ -141,9 +140,16 @@ Settings read_settings(const std::filesystem::path& yaml) {
   //   "---" line is allowed and nothing else;
   // - a key indented less than the first key (" t: 0\nL: -\na"): invalid YAML anyway (the first key
   //   sets the top-level map's indentation), so it is refused with its line.
+  // It also recurses once per nesting level and overflows the stack on deep nesting ('[' x 50000):
+  // settings are flat, so nesting beyond kMaxNesting levels (flow brackets, indentation and "- " items)
+  // is refused with its line. And it keeps the last of two equal keys: each top-level key once.
   {
+    constexpr std::size_t kMaxNesting = 64;
     std::size_t line_no = 0, markers = 0, pos = 0;
     std::optional<std::pair<std::size_t, std::size_t>> first_key;  // (indentation, line)
+    std::size_t flow = 0;                 // open '[' and '{' (they may span lines)
+    std::vector<std::size_t> indents;     // indentation of the enclosing block levels
+    std::map<std::string, std::size_t> top_keys;  // key -> line
     while (pos < text.size()) {
       const std::size_t end = std::min(text.find('\n', pos), text.size());
       std::string_view line(text.data() + pos, end - pos);
@@ -170,6 +176,51 @@ Settings read_settings(const std::filesystem::path& yaml) {
                          fmt::format("expected 'Key: value' indented like the first key (line {}, {} spaces), "
                                      "found {} spaces",
                                      first_key->second, first_key->first, indent));
+      }
+      const bool top_level = flow == 0 && indent == first_key->first;
+      // block nesting: indentation levels, and "- - x" items nested on one line
+      if (flow == 0) {
+        while (!indents.empty() && indents.back() >= indent) indents.pop_back();
+        indents.push_back(indent);
+      }
+      std::size_t items = 0;
+      for (std::size_t k = 0; k + 1 < content.size() && content[k] == '-' && (content[k + 1] == ' ' || content[k + 1] == '\t');) {
+        ++items;
+        k = std::min(content.find_first_not_of(" \t", k + 1), content.size());
+      }
+      // flow nesting, outside quotes and comments
+      char quote = 0;
+      std::size_t deepest = flow;
+      for (std::size_t k = 0; k < content.size(); ++k) {
+        const char c = content[k];
+        if (quote != 0) {
+          if (c == quote) quote = 0;
+        } else if (c == '"' || c == '\'') {
+          quote = c;
+        } else if (c == '#' && (k == 0 || content[k - 1] == ' ' || content[k - 1] == '\t')) {
+          break;
+        } else if (c == '[' || c == '{') {
+          deepest = std::max(deepest, ++flow);
+        } else if ((c == ']' || c == '}') && flow > 0) {
+          --flow;
+        }
+      }
+      if (indents.size() + items + deepest > kMaxNesting) {
+        throw ParseError(yaml, line_no,
+                         fmt::format("nested deeper than {} levels (expected flat 'Key: value' settings)", kMaxNesting));
+      }
+      if (top_level && items == 0) {
+        std::string_view key = content.substr(0, content.find(':'));
+        while (!key.empty() && (key.back() == ' ' || key.back() == '\t')) key.remove_suffix(1);
+        if (key.size() >= 2 && (key.front() == '"' || key.front() == '\'') && key.back() == key.front()) {
+          key = key.substr(1, key.size() - 2);
+        }
+        const auto [it, inserted] = top_keys.emplace(std::string(key), line_no);
+        if (!inserted) {
+          throw ParseError(yaml, line_no,
+                           fmt::format("key '{}' given twice (lines {} and {}); expected each key once", key,
+                                       it->second, line_no));
+        }
       }
     }
   }
@@ -228,6 +279,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
     if (const auto h = r.integer({"Camera.height", "Camera1.height"})) cam.height = *h;
     if (!(cam.fx > 0.0 && cam.fy > 0.0)) r.fail("Camera.fx", "positive focal lengths (Camera.fx, Camera.fy)");
     if (cam.width < 0 || cam.height < 0) r.fail("Camera.width", "a non-negative image size");
+    if (const auto why = cam.implausibility()) r.fail("Camera.fx", fmt::format("plausible intrinsics: {}", *why));
     s.camera = cam;
   }
   s.fps = r.number({"Camera.fps"});

@@ -1,6 +1,7 @@
 #include "text.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 
 #include <fmt/format.h>
 
@@ -39,19 +40,24 @@ bool is_comment_or_blank(std::string_view line) {
 }
 
 std::ifstream open_for_reading(const std::filesystem::path& file, std::string_view what) {
+  return open_input_file(file, what);
+}
+
+bool read_line(std::istream& in, std::string& line, std::size_t& line_no) {
+  if (!std::getline(in, line)) return false;
+  if (++line_no == 1 && line.starts_with("\xEF\xBB\xBF")) line.erase(0, 3);
+  return true;
+}
+
+void for_each_record(const std::filesystem::path& file, std::string_view what, std::size_t count,
+                     std::string_view record,
+                     const std::function<void(std::size_t line_no, std::span<const double> numbers)>& on_record) {
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec)) {
     throw ParseError(file, 0, fmt::format("is a directory (expected {})", what));
   }
   std::ifstream in(file);
   if (!in) throw ParseError(file, 0, fmt::format("cannot open the file (expected {})", what));
-  return in;
-}
-
-void for_each_record(const std::filesystem::path& file, std::string_view what, std::size_t count,
-                     std::string_view record,
-                     const std::function<void(std::size_t line_no, std::span<const double> numbers)>& on_record) {
-  auto in = open_for_reading(file, what);
   for_each_record(in, file, count, record, on_record);
 }
 
@@ -60,8 +66,7 @@ void for_each_record(std::istream& in, const std::filesystem::path& file, std::s
   std::vector<double> numbers(count);
   std::string line;
   std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
+  while (read_line(in, line, line_no)) {
     if (is_comment_or_blank(line)) continue;
     const auto tokens = split(line);
     if (tokens.size() != count) {

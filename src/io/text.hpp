@@ -18,10 +18,14 @@ std::vector<std::string_view> split(std::string_view line);
 // True for blank lines and '#' comments.
 bool is_comment_or_blank(std::string_view line);
 
-// Opens a text file for reading or throws ParseError(file, 0, "cannot open ... (expected <what>)").
+// Opens a dataset's text file for reading or throws ParseError(file, 0, "... (expected <what>)"): it
+// must be a regular file (rgbl::require_input_file), never a FIFO that could block forever.
 std::ifstream open_for_reading(const std::filesystem::path& file, std::string_view what);
 
-// Reads a file of numeric records, one per line (blank lines and '#' comments skipped): calls
+// std::getline that also counts lines and drops a UTF-8 byte order mark at the start of line 1.
+bool read_line(std::istream& in, std::string& line, std::size_t& line_no);
+
+// Reads a file of numeric records (any readable file, pipes too: `rgbl eval <(...)`), one per line (blank lines and '#' comments skipped): calls
 // on_record(line_no, numbers) with exactly `count` finite numbers, or throws ParseError(file, line,
 // "expected <record>, found N fields") / ("field K '...' is not a finite number"). `what` describes
 // the file for open_for_reading.

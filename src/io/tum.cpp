@@ -1,6 +1,7 @@
 // TUM RGB-D loader.
 #include "file_sequence.hpp"
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
 #include "rgbl/core/log.hpp"
 #include "rgbl/io/sequence.hpp"
 #include "text.hpp"
@@ -8,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace rgbl {
@@ -27,12 +29,11 @@ std::vector<ListEntry> read_file_list(const fs::path& list, const fs::path& dir)
   std::string line;
   std::size_t line_no = 0;
   std::error_code ec;
-  while (std::getline(in, line)) {
-    ++line_no;
+  while (detail::read_line(in, line, line_no)) {
     if (detail::is_comment_or_blank(line)) continue;
     const auto tokens = detail::split(line);
     ListEntry e;
-    if (tokens.size() != 2 || !detail::parse_double(tokens[0], e.timestamp)) {
+    if (tokens.size() != 2 || !detail::parse_double(tokens[0], e.timestamp) || !std::isfinite(e.timestamp)) {
       throw ParseError(list, line_no, "expected 'timestamp filename'");
     }
     if (!entries.empty() && e.timestamp <= entries.back().timestamp) {
@@ -70,15 +71,16 @@ void TumOptions::validate() const {
   require(depth_factor > 0.0, "depth_factor", "a positive number of depth units per metre");
   require(max_time_difference >= 0.0, "max_time_difference", "a non-negative time in seconds");
   require(max_ground_truth_gap > 0.0, "max_ground_truth_gap", "a positive time in seconds");
-  if (camera) camera->validate();
+  if (camera) {
+    camera->validate();
+    if (const auto why = camera->implausibility()) throw ConfigError("camera", *why);
+  }
 }
 
 std::unique_ptr<Sequence> open_tum_rgbd(const fs::path& tum_dir, const TumOptions& tum, const LoadOptions& options) {
   tum.validate();
   std::error_code ec;
-  if (!fs::is_directory(tum_dir, ec)) {
-    throw ParseError(tum_dir, 0, "not a folder (expected a TUM RGB-D folder with rgb.txt, depth.txt, rgb/, depth/)");
-  }
+  require_input_folder(tum_dir, "a TUM RGB-D folder with rgb.txt, depth.txt, rgb/, depth/");
   fs::path dir = tum_dir.lexically_normal();
   if (!dir.has_filename()) dir = dir.parent_path();
   detail::SequenceTable table;
@@ -124,6 +126,7 @@ std::unique_ptr<Sequence> open_tum_rgbd(const fs::path& tum_dir, const TumOption
 
   const auto gt_file = dir / "groundtruth.txt";
   if (fs::exists(gt_file, ec)) {
+    require_input_file(gt_file, "a TUM trajectory: 't tx ty tz qx qy qz qw' per line");  // the reader takes pipes
     const Trajectory samples = read_tum_trajectory(gt_file);
     Trajectory gt;
     std::size_t k = 0;

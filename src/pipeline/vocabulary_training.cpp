@@ -1,6 +1,7 @@
 #include "rgbl/pipeline/vocabulary_training.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/io/image.hpp"
 #include "rgbl/core/timer.hpp"
 
 #include <opencv2/imgcodecs.hpp>
@@ -50,8 +51,7 @@ VocabularyTraining train_vocabulary(const std::vector<std::filesystem::path>& fo
   std::vector<Keypoint> keypoints;
   VocabularyTraining out;
   for (const auto& image : images) {
-    const cv::Mat gray = cv::imread(image.string(), cv::IMREAD_GRAYSCALE);
-    if (gray.empty()) throw ParseError(image, 0, "cannot be read as an image");
+    const cv::Mat gray = read_image_file(image, cv::IMREAD_GRAYSCALE);
     descriptors.emplace_back();
     extractor.extract(gray, keypoints, descriptors.back());
     out.descriptors += descriptors.back().size();

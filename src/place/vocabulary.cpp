@@ -319,12 +319,7 @@ Vocabulary Vocabulary::from_bytes(std::span<const std::uint8_t> bytes, const std
 }
 
 Vocabulary Vocabulary::load(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) {
-    throw ParseError(file, 0, "missing or not a regular file (expected a vocabulary written by `rgbl vocab train`)");
-  }
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw ParseError(file, 0, "cannot be opened for reading (expected a vocabulary)");
+  std::ifstream in = open_input_file(file, "a vocabulary written by `rgbl vocab train`", true);
   const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw ParseError(file, 0, "read error (expected a vocabulary)");
   return from_bytes(bytes, file);

@@ -276,6 +276,27 @@ TEST_CASE("stereo source: depth = fx * baseline / disparity on a shifted texture
   CHECK_THROWS_WITH(source->prepare(frame), Contains("frame.image_right"));
 }
 
+TEST_CASE("stereo source: images no wider than the disparity range are refused before OpenCV aborts") {
+  auto settings = simple_settings();
+  settings.stereo_baseline = 0.5;
+  settings.calibration.camera.height = 60;
+  rgbl::StereoSourceOptions stereo;  // 128 disparities
+  for (const int width : {100, 128}) {  // OpenCV aborted (SIGABRT) at 100 px, failed an assertion at 128
+    settings.calibration.camera.width = width;
+    CHECK_THROWS_WITH(rgbl::make_stereo_source(stereo, settings),
+                      Contains("'--depth'") && Contains("stereo.num_disparities = 128 px") &&
+                          Contains(std::to_string(width) + " px wide"));
+  }
+  settings.calibration.camera.width = 129;
+  auto source = rgbl::make_stereo_source(stereo, settings);
+  rgbl::SensorFrame frame;
+  cv::Mat texture(60, 129, CV_8UC1);
+  cv::randu(texture, 0, 255);
+  frame.image = texture;
+  frame.image_right = texture;
+  CHECK_NOTHROW(source->prepare(frame));
+}
+
 TEST_CASE("lidar source with IP-Basic completion samples its dense map") {
   auto settings = simple_settings();
   auto lidar = simple_lidar();

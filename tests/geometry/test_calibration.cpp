@@ -4,6 +4,10 @@
 #include "support/temp_dir.hpp"
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
+
+#include <sstream>
+#include <string>
 
 using Catch::Matchers::Contains;
 using Catch::Matchers::WithinAbs;
@@ -55,7 +59,7 @@ TEST_CASE("calibration errors name the file, the line and what was expected") {
   rgbl::test::TempDir dir;
   SECTION("missing file") {
     CHECK_THROWS_WITH(rgbl::read_kitti_odometry_calibration(dir.path() / "nope.txt"),
-                      Contains("nope.txt") && Contains("cannot open"));
+                      Contains("nope.txt") && Contains("missing"));
   }
   SECTION("missing key") {
     const auto file = dir.write("calib.txt", "P0: 1 0 0 0 0 1 0 0 0 0 1 0\n");
@@ -82,6 +86,75 @@ TEST_CASE("calibration errors name the file, the line and what was expected") {
     const auto file = dir.write("calib.txt", text);
     CHECK_THROWS_WITH(rgbl::read_kitti_odometry_calibration(file), Contains("positive focal lengths"));
   }
+}
+
+TEST_CASE("calibration: implausible intrinsics, non-rigid Tr, duplicate keys refused; a byte order mark is skipped") {
+  rgbl::test::TempDir dir;
+  const auto error_of = [&](const std::string& text, int width = 0, int height = 0) -> std::string {
+    const auto file = dir.write("calib.txt", text);
+    try {
+      (void)rgbl::read_kitti_odometry_calibration(file, width, height);
+    } catch (const rgbl::ParseError& e) {
+      CHECK(e.file() == file);
+      return e.what();
+    }
+    return "no error";
+  };
+  const auto with_p0_focal = [](const std::string& f) {
+    std::string text = kSeq04Calib;
+    text.replace(text.find("7.070912e+02"), 12, f);
+    text.replace(text.find("7.070912e+02"), 12, f);  // fy: the second of the line
+    return text;
+  };
+  // these gave a trajectory of -nan rows and "ATE RMSE -nan m"
+  CHECK_THAT(error_of(with_p0_focal("1e-300")), Contains("calib.txt:1: 'P0': focal lengths fx 1e-300 fy 1e-300 px"));
+  CHECK_THAT(error_of(with_p0_focal("1e155")), Contains("calib.txt:1: 'P0': focal lengths"));
+  // relative to the image, when its size is known
+  CHECK_THAT(error_of(with_p0_focal("5"), 1226, 370), Contains("implausible for a 1226x370 image"));
+  CHECK(error_of(with_p0_focal("5")) == "no error");  // no size yet: the loader checks once it has one
+  std::string text = kSeq04Calib;
+  text.replace(text.find("6.018873e+02"), 12, "6.018873e+05");
+  CHECK_THAT(error_of(text, 1226, 370), Contains("principal point"));
+  // Tr all zeros, or its rotation scaled by 2
+  const std::string tr_zero = std::string(kSeq04Calib).substr(0, std::string(kSeq04Calib).find("Tr:")) +
+                              "Tr: 0 0 0 0 0 0 0 0 0 0 0 0\n";
+  CHECK_THAT(error_of(tr_zero), Contains("calib.txt:5: expected 'Tr' to hold a rotation matrix"));
+  const std::string tr_scaled = std::string(kSeq04Calib).substr(0, std::string(kSeq04Calib).find("Tr:")) +
+                                "Tr: 0 -2 0 0 0 0 -2 -0.08 2 0 0 -0.27\n";
+  CHECK_THAT(error_of(tr_scaled), Contains("calib.txt:5: expected 'Tr' to hold a rotation matrix"));
+  const std::string tr_far = std::string(kSeq04Calib).substr(0, std::string(kSeq04Calib).find("Tr:")) +
+                             "Tr: 0 -1 0 0 0 0 -1 -0.08 1 0 0 1e300\n";
+  CHECK_THAT(error_of(tr_far), Contains("calib.txt:5: expected 'Tr' to hold a translation"));
+  // a second P0 used to replace the first silently
+  CHECK_THAT(error_of(std::string(kSeq04Calib) + "P0: 1 0 0 0 0 1 0 0 0 0 1 0\n"),
+             Contains("calib.txt:6: 'P0' given twice (lines 1 and 6)"));
+  // a UTF-8 byte order mark (Windows editors) used to hide the first key
+  CHECK(error_of("\xEF\xBB\xBF" + std::string(kSeq04Calib)) == "no error");
+}
+
+TEST_CASE("raw calibration: velo_to_cam R must be a rotation, R_rect_00 too") {
+  rgbl::test::TempDir dir;
+  std::string cam;
+  for (int i = 0; i < 4; ++i) {
+    cam += fmt::format("S_rect_0{}: 1.242000e+03 3.750000e+02\n", i);
+    cam += fmt::format("P_rect_0{}: 7.215377e+02 0 6.095593e+02 0 0 7.215377e+02 1.728540e+02 0 0 0 1 0\n", i);
+  }
+  const std::string rect = "R_rect_00: 1 0 0 0 1 0 0 0 1\n";
+  const std::string velo = "calib_time: 15-Mar-2012 11:37:16\nR: 0 -1 0 0 0 -1 1 0 0\nT: 0 -0.08 -0.27\n";
+  const auto parse = [&](const std::string& c, const std::string& v) -> std::string {
+    std::istringstream cam_in(c), velo_in(v);
+    try {
+      (void)rgbl::parse_kitti_raw_calibration(cam_in, "calib_cam_to_cam.txt", velo_in, "calib_velo_to_cam.txt");
+    } catch (const rgbl::ParseError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  CHECK(parse(cam + rect, velo) == "no error");
+  CHECK_THAT(parse(cam + rect, "R: 0 -2 0 0 0 -2 2 0 0\nT: 0 -0.08 -0.27\n"),
+             Contains("calib_velo_to_cam.txt:1: expected 'R' to hold a rotation matrix"));
+  CHECK_THAT(parse(cam + "R_rect_00: 0 0 0 0 0 0 0 0 0\n", velo),
+             Contains("calib_cam_to_cam.txt:9: expected 'R_rect_00' to hold a rotation matrix"));
 }
 
 TEST_CASE("raw calibration chains velodyne -> cam0 -> rectified -> camera i") {

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <limits>
+#include <sys/stat.h>
 
 using Catch::Matchers::Contains;
 
@@ -120,6 +121,20 @@ TEST_CASE("scan reader checks the record size") {
   CHECK(static_cast<const void*>(view.data()) == static_cast<const void*>(raw));
   CHECK(view[0].z == 3.0F);
   CHECK(rgbl::view_kitti_scan(std::span<const float>(raw, 7)).empty());
+}
+
+TEST_CASE("scan reader refuses folders, FIFOs and scans beyond kMaxScanPoints, naming the file") {
+  rgbl::test::TempDir dir;
+  // a folder used to report its size as 9223372036854775807 bytes
+  std::filesystem::create_directories(dir.path() / "folder.bin");
+  CHECK_THROWS_WITH(rgbl::read_kitti_scan(dir.path() / "folder.bin"), Contains("folder.bin: is a directory"));
+  const auto fifo = dir.path() / "fifo.bin";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  CHECK_THROWS_WITH(rgbl::read_kitti_scan(fifo), Contains("fifo.bin: is not a regular file"));
+  // one point too many (a sparse file: nothing is written), refused before allocating
+  const auto huge = dir.write("huge.bin", "");
+  std::filesystem::resize_file(huge, (rgbl::kMaxScanPoints + 1) * 16);
+  CHECK_THROWS_WITH(rgbl::read_kitti_scan(huge), Contains("huge.bin: holds 10000001 points, more than rgbl reads"));
 }
 
 TEST_CASE("real KITTI seq 04: all 51 scans into camera 2") {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <sys/stat.h>
 
 using Catch::Matchers::Contains;
 using Catch::Matchers::WithinAbs;
@@ -203,7 +204,7 @@ TEST_CASE("KITTI loader: bad input names the file", "[io][kitti][bad-input]") {
     CHECK_THAT(parse_error_message([&] { rgbl::open_kitti_odometry(tmp.path() / "nope"); }, tmp.path() / "nope"),
                Contains("not a folder"));
     CHECK_THAT(parse_error_message([&] { rgbl::open_kitti_odometry(tmp.path()); }, tmp.path() / "calib.txt"),
-               Contains("cannot open"));
+               Contains("missing"));
     CHECK_THAT(parse_error_message([&] { rgbl::open_sequence(tmp.path()); }, tmp.path()),
                Contains("cannot tell the dataset format"));
     CHECK_THAT(parse_error_message([&] { rgbl::open_sequence(tmp.path() / "x"); }, tmp.path() / "x"),
@@ -225,4 +226,43 @@ TEST_CASE("KITTI loader: bad input names the file", "[io][kitti][bad-input]") {
     rgbl::test::SyntheticKitti kitti(0, 0);
     CHECK_THAT(parse_error_message([&] { rgbl::open_kitti_odometry(kitti.dir); }, kitti.dir), Contains("no frames"));
   }
+}
+
+TEST_CASE("KITTI loader: times.txt must increase strictly; BOM skipped; FIFOs refused, not read", "[io][kitti][bad-input]") {
+  rgbl::test::SyntheticKitti kitti;
+  const auto times = kitti.dir / "times.txt";
+  // duplicate and decreasing times used to pass, and the TUM trajectory written then was refused by rgbl eval
+  kitti.root.write("sequences/07/times.txt", "0.0\n0.1\n0.1\n");
+  CHECK_THAT(parse_error_message([&] { rgbl::open_kitti_odometry(kitti.dir); }, times),
+             Contains("times.txt:3: timestamp 0.1 is not after the one on line 2 (0.1)"));
+  kitti.root.write("sequences/07/times.txt", "0.0\n0.2\n\n0.1\n");
+  CHECK_THAT(parse_error_message([&] { rgbl::read_kitti_times(times); }, times),
+             Contains("times.txt:4: timestamp 0.1 is not after the one on line 2 (0.2)"));
+  kitti.root.write("sequences/07/times.txt", "0.0\n0.1\nnan\n");
+  CHECK_THAT(parse_error_message([&] { rgbl::read_kitti_times(times); }, times), Contains("times.txt:3:"));
+  kitti.root.write("sequences/07/times.txt", "\xEF\xBB\xBF" "0.0\n0.1\n0.2\n");
+  CHECK(rgbl::open_kitti_odometry(kitti.dir)->size() == 3);
+  // a FIFO as calib.txt or as a scan used to block forever
+  std::filesystem::remove(kitti.dir / "calib.txt");
+  REQUIRE(::mkfifo((kitti.dir / "calib.txt").c_str(), 0600) == 0);
+  CHECK_THAT(parse_error_message([&] { rgbl::open_kitti_odometry(kitti.dir); }, kitti.dir / "calib.txt"),
+             Contains("is not a regular file"));
+  kitti.root.write("sequences/07/calib.txt.new", rgbl::test::kSmallCalib);
+  std::filesystem::rename(kitti.dir / "calib.txt.new", kitti.dir / "calib.txt");
+  std::filesystem::remove(kitti.scan(1));
+  REQUIRE(::mkfifo(kitti.scan(1).c_str(), 0600) == 0);
+  const auto seq = rgbl::open_kitti_odometry(kitti.dir);
+  CHECK_THAT(parse_error_message([&] { seq->load(1); }, kitti.scan(1)), Contains("is not a regular file"));
+}
+
+TEST_CASE("KITTI loader: intrinsics implausible for the images' size name calib.txt", "[io][kitti][bad-input]") {
+  rgbl::test::SyntheticKitti kitti;
+  // fx = fy = 1000 px on 8x6 images: a 0.46 degree field of view
+  kitti.root.write("sequences/07/calib.txt", "P0: 1000 0 3.5 0 0 1000 2.5 0 0 0 1 0\n"
+                                              "P1: 50 0 3.5 -25 0 50 2.5 0 0 0 1 0\n"
+                                              "P2: 50 0 3.5 3 0 50 2.5 0 0 0 1 0\n"
+                                              "P3: 50 0 3.5 -22 0 50 2.5 0 0 0 1 0\n"
+                                              "Tr: 0 -1 0 0 0 0 -1 -0.08 1 0 0 -0.27\n");
+  CHECK_THAT(parse_error_message([&] { rgbl::open_kitti_odometry(kitti.dir); }, kitti.dir / "calib.txt"),
+             Contains("camera 0: focal lengths fx 1000 fy 1000 px are implausible for a 8x6 image"));
 }

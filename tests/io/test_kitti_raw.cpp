@@ -4,6 +4,7 @@
 #include "rgbl/io/sequence.hpp"
 #include "support/data.hpp"
 #include "support/temp_dir.hpp"
+#include "support/parse_error.hpp"
 
 #include "synthetic.hpp"
 
@@ -211,4 +212,17 @@ TEST_CASE("KITTI raw loader: missing packets, counts and sizes", "[io][kitti-raw
     CHECK_FALSE(seq->ground_truth());
     CHECK_THAT(seq->notes().at(0), Contains("calib_imu_to_velo.txt is missing"));
   }
+}
+
+TEST_CASE("KITTI raw loader: frame timestamps must increase strictly", "[io][kitti-raw][bad-input]") {
+  SyntheticRaw raw;
+  const auto times = raw.drive / "image_00" / "timestamps.txt";
+  raw.tmp.write("2011_01_01_drive_0001_sync/image_00/timestamps.txt",
+                "2011-01-01 10:00:00.500000000\n2011-01-01 10:00:01.500000000\n2011-01-01 10:00:01.500000000\n");
+  CHECK_THAT(rgbl::test::parse_error_message([&] { rgbl::open_kitti_raw(raw.drive); }, times),
+             Contains(":3: timestamp") && Contains("is not after the one on line 2"));
+  raw.tmp.write("2011_01_01_drive_0001_sync/image_00/timestamps.txt",
+                "2011-01-01 10:00:02.500000000\n2011-01-01 10:00:01.500000000\n2011-01-01 10:00:03.500000000\n");
+  CHECK_THAT(rgbl::test::parse_error_message([&] { rgbl::read_kitti_raw_timestamps(times); }, times),
+             Contains(":2: timestamp"));
 }

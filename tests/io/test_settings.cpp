@@ -200,7 +200,7 @@ TEST_CASE("settings: wrong types, incomplete groups and bad values name file and
   CHECK_THAT(error_of(tmp.write("k.yaml", "just some text\n")), Contains("not a readable YAML settings file"));
   CHECK_THAT(error_of(tmp.write("l.yaml", "\n")), Contains("is empty"));
   CHECK_THAT(error_of(tmp.path() / "missing.yaml"), Contains("missing"));
-  CHECK_THAT(error_of(tmp.path()), Contains("not a file"));
+  CHECK_THAT(error_of(tmp.path()), Contains("is a directory"));
 }
 
 TEST_CASE("settings: input on which OpenCV's parser throws standard exceptions is a ParseError", "[io][settings][bad-input]") {
@@ -220,4 +220,30 @@ TEST_CASE("settings: input on which OpenCV's parser throws standard exceptions i
   CHECK(rgbl::read_settings(tmp.write("indented.yaml", "# c\n  Camera.fps: 10.0\n\n  Camera.RGB: 1\n")).fps == 10.0);
   // One plain document start is fine.
   CHECK(rgbl::read_settings(tmp.write("one.yaml", "%YAML:1.0\n---\nCamera.fps: 10.0\n")).fps == 10.0);
+}
+
+TEST_CASE("settings: deep nesting, duplicate keys and byte order marks", "[io][settings][bad-input]") {
+  rgbl::test::TempDir tmp;
+  // 50 000 nested brackets overflowed the stack inside OpenCV's YAML parser (SIGSEGV)
+  const std::string deep = "a: " + std::string(50000, '[') + std::string(50000, ']') + "\n";
+  CHECK_THAT(error_of(tmp.write("deep.yaml", deep)), Contains("deep.yaml:1: nested deeper than 64 levels"));
+  CHECK_THAT(error_of(tmp.write("maps.yaml", "%YAML:1.0\nb: 1\na: " + std::string(70, '{') + "\n")),
+             Contains("maps.yaml:3: nested deeper than 64 levels"));
+  std::string block = "a:\n";
+  for (int depth = 1; depth < 80; ++depth) block += std::string(static_cast<std::size_t>(depth), ' ') + "- \n";
+  CHECK_THAT(error_of(tmp.write("block.yaml", block)), Contains("block.yaml:64: nested deeper than 64 levels"));
+  // brackets in strings and comments do not count; a few levels are fine
+  const auto quoted = tmp.write("quoted.yaml", "%YAML:1.0\nLiDAR.Method: \"" + std::string(100, '[') +
+                                                   "\"  # " + std::string(100, '{') + "\nViewer.x: [[1, 2], [3]]\n");
+  CHECK(rgbl::read_settings(quoted).lidar_method == std::string(100, '['));
+  // the second of two equal keys used to win silently
+  CHECK_THAT(error_of(tmp.write("dup.yaml", "%YAML:1.0\nORBextractor.nFeatures: 100\n# again\n"
+                                            "ORBextractor.nFeatures: 200\n")),
+             Contains("dup.yaml:4: key 'ORBextractor.nFeatures' given twice (lines 2 and 4)"));
+  // a UTF-8 byte order mark (Windows editors) is skipped
+  const auto bom = rgbl::read_settings(tmp.write("bom.yaml", "\xEF\xBB\xBFORBextractor.nFeatures: 1000\n"));
+  CHECK(bom.orb.n_features == 1000);
+  // intrinsics that cannot be a camera's
+  CHECK_THAT(error_of(tmp.write("f.yaml", replace(kRgblYaml, "Camera.fx: 707.0912", "Camera.fx: 1e-300"))),
+             Contains("key 'Camera.fx': expected plausible intrinsics"));
 }

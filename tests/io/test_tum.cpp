@@ -104,7 +104,7 @@ TEST_CASE("TUM loader: bad input names the file", "[io][tum][bad-input]") {
   }
   SECTION("no rgb.txt") {
     rgbl::test::TempDir tmp;
-    CHECK_THROWS_WITH(rgbl::open_tum_rgbd(tmp.path()), Contains("rgb.txt") && Contains("cannot open"));
+    CHECK_THROWS_WITH(rgbl::open_tum_rgbd(tmp.path()), Contains("rgb.txt") && Contains("missing"));
   }
   SECTION("bad options") {
     SyntheticTum tum;

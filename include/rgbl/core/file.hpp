@@ -1,11 +1,15 @@
 #pragma once
 // Writing files so that a reader never sees half of one, and the folders runs write into: every
-// writer in rgbl goes through here.
+// writer in rgbl goes through here. Reading an input file only once it is known to be a regular file
+// this process may read: every reader of dataset, calibration, settings and vocabulary files checks it
+// here first.
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <string>
+#include <string_view>
 
 namespace rgbl {
 
@@ -49,5 +53,25 @@ class TemporaryFolder {
  private:
   std::filesystem::path path_;
 };
+
+// Throws ParseError(file, 0, "<problem> (expected <what>)") unless `file` is a regular file that can be
+// read: missing, a folder, not a regular file (a FIFO or device, whose reading may block forever) and
+// "cannot read: permission denied" each get their own message.
+void require_input_file(const std::filesystem::path& file, std::string_view what);
+
+// Throws ParseError(dir, 0, ...) unless `dir` is a folder whose entries can be listed (missing, not a
+// folder, "cannot read: permission denied").
+void require_input_folder(const std::filesystem::path& dir, std::string_view what);
+
+// require_input_file, then opens it for reading (binary or text).
+std::ifstream open_input_file(const std::filesystem::path& file, std::string_view what, bool binary = false);
+
+// The largest image rgbl decodes: 50 megapixels (8K video is 33). A bigger image would take gigabytes
+// once decoded, so its header is refused before decoding.
+inline constexpr std::uint64_t kMaxImagePixels = 50'000'000;
+
+// require_input_file, and for a PNG (the datasets' format) a header of at most kMaxImagePixels pixels.
+// Other formats are left to the decoder.
+void require_image_file(const std::filesystem::path& file, std::string_view what);
 
 }  // namespace rgbl

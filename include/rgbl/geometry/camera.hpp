@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 
 #include <optional>
+#include <string>
 
 namespace rgbl {
 
@@ -35,6 +36,11 @@ struct PinholeCamera {
 
   // Throws ConfigError when focal lengths are not positive or the size is empty.
   void validate() const;
+  // Why these intrinsics cannot be a real camera's (nullopt when they can): every number finite,
+  // focal lengths of 1..1e6 px and, when the size is known (> 0), 0.02..100 times the larger image side
+  // (fields of view of 0.6..175 degrees), the principal point within the image widened by its size on
+  // each side. Without a size only the absolute bounds apply (|cx|, |cy| <= 1e6).
+  std::optional<std::string> implausibility() const;
 
   Eigen::Matrix3d K() const;
 

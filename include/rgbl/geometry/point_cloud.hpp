@@ -26,8 +26,12 @@ using PointCloudView = std::span<const LidarPoint>;
 // Returns an empty view when the size is not a multiple of 4.
 PointCloudView view_kitti_scan(std::span<const float> packed);
 
+// The most points read_kitti_scan reads from one file: 10 million (160 MB; a KITTI scan has ~120 000).
+inline constexpr std::size_t kMaxScanPoints = 10'000'000;
+
 // Reads a KITTI .bin into `points` (reusing its capacity). Throws ParseError naming the file when it
-// cannot be read or its size is not a multiple of 16 bytes. Non-finite points are kept: the kernels
+// is not a readable regular file, its size is not a multiple of 16 bytes or it holds more than
+// kMaxScanPoints points. Non-finite points are kept: the kernels
 // skip them, and callers may want to count them.
 void read_kitti_scan(const std::filesystem::path& path, std::vector<LidarPoint>& points);
 std::vector<LidarPoint> read_kitti_scan(const std::filesystem::path& path);

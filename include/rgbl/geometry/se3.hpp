@@ -27,6 +27,10 @@ Eigen::Isometry3d interpolate(const Eigen::Isometry3d& T_a, const Eigen::Isometr
 // Angle of a rotation in radians, in [0, pi].
 double rotation_angle(const Eigen::Matrix3d& R);
 
+// How far R is from a rotation: the larger of max|R^T R - I| and |det R - 1|; NaN for non-finite R.
+// Rotations printed with 7 significant digits (KITTI's calibration files) are off by ~1e-7.
+double rotation_error(const Eigen::Matrix3d& R);
+
 Eigen::Isometry3d make_isometry(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
 Eigen::Isometry3d isometry_from_3x4(const Matrix34d& M);
 Matrix34d to_3x4(const Eigen::Isometry3d& T);

@@ -25,7 +25,11 @@ OxtsPacket read_oxts_packet(const std::filesystem::path& file);
 std::vector<Eigen::Isometry3d> oxts_imu_poses(std::span<const OxtsPacket> packets);
 
 // Reads a calib_imu_to_velo.txt or calib_velo_to_cam.txt ("R: 9 numbers", "T: 3 numbers") as the
-// transform it describes (T_velo_imu, T_cam_velo).
+// transform it describes (T_velo_imu, T_cam_velo). R must be a rotation to 1e-4 and T at most 100 m.
 Eigen::Isometry3d read_kitti_rigid_transform(const std::filesystem::path& file);
+
+// A raw sensor's timestamps.txt ("YYYY-MM-DD hh:mm:ss.fraction" per line) in seconds since 1970,
+// strictly increasing. Throws ParseError naming the file and line.
+std::vector<double> read_kitti_raw_timestamps(const std::filesystem::path& file);
 
 }  // namespace rgbl

@@ -71,6 +71,10 @@ class Sequence {
 std::unique_ptr<Sequence> open_kitti_odometry(const std::filesystem::path& sequence_dir,
                                               const LoadOptions& options = {});
 
+// A KITTI odometry times.txt: one time in seconds per line (blank lines skipped), finite and strictly
+// increasing. Throws ParseError naming the file and line.
+std::vector<double> read_kitti_times(const std::filesystem::path& times_txt);
+
 // KITTI raw drive (<date>/<date>_drive_XXXX_sync): image_0x/data, velodyne_points/data, oxts/data,
 // the calib_*.txt one level up. Ground truth of rectified cam0 from the OXTS packets (see kitti_raw.hpp).
 std::unique_ptr<Sequence> open_kitti_raw(const std::filesystem::path& drive_dir, const LoadOptions& options = {});
