@@ -62,9 +62,14 @@ def test_every_registered_source_is_created_by_name(camera):
     names = rgbl.depth_source_names()
     assert names == ["lidar", "precomputed", "rgbd", "stereo", "stereo_sparse"]
     for spec in ["lidar", "lidar:dilated", "lidar:ipbasic", "lidar:ipbasic-multiscale", "lidar:cross7", "rgbd",
-                 "stereo", "stereo_sparse"]:
+                 "stereo_sparse"]:
         source = rgbl.make_depth_source(spec, calibration, stereo_baseline=0.5)
         assert source.name == spec.split(":")[0]
+    # dense stereo needs images wider than its 128 px disparity range: refused on this 101 px camera
+    with pytest.raises(rgbl.ConfigError, match="wider than its disparity range"):
+        rgbl.make_depth_source("stereo", calibration, stereo_baseline=0.5)
+    wide = rgbl.CameraCalibration(rgbl.PinholeCamera(fx=100.0, fy=100.0, cx=150.0, cy=30.0, width=301, height=61))
+    assert rgbl.make_depth_source("stereo", wide, stereo_baseline=0.5).name == "stereo"
     assert rgbl.depth_source_needs("lidar").scan
     assert rgbl.depth_source_needs("stereo").right_image
     assert rgbl.depth_source_needs("rgbd").depth_image

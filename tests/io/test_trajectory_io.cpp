@@ -103,7 +103,7 @@ TEST_CASE("trajectory readers name file and line of malformed rows", "[io][traje
   const auto kitti_as_tum = tmp.write("h.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n");
   require_parse_error([&] { rgbl::read_tum_trajectory(kitti_as_tum); }, kitti_as_tum, 1, "found 12 fields");
   const auto missing = tmp.path() / "nope.txt";
-  require_parse_error([&] { rgbl::read_kitti_trajectory(missing); }, missing, 0, "cannot open");
+  require_parse_error([&] { rgbl::read_kitti_trajectory(missing); }, missing, 0, "missing (expected a KITTI trajectory");
   require_parse_error([&] { rgbl::read_tum_trajectory(tmp.path()); }, tmp.path(), 0, "is a directory");
 }
 
