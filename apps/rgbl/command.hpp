@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -33,6 +34,22 @@ inline CLI::Validator whole_number(std::uint64_t min, std::uint64_t max = 1'000'
             return {};
           },
           fmt::format("INT in {}..{}", min, max)};
+}
+
+// Check of a real-valued option: a finite number above `min`, or from `min` on when inclusive.
+// (CLI11's PositiveNumber prints a 309-digit range for 0.)
+inline CLI::Validator finite_number(double min, bool inclusive) {
+  return {[min, inclusive](std::string& text) -> std::string {
+            double value = 0.0;
+            const char* end = text.data() + text.size();
+            const auto [stop, error] = std::from_chars(text.data(), end, value);
+            const bool in_range = inclusive ? value >= min : value > min;
+            if (error != std::errc() || stop != end || !std::isfinite(value) || !in_range) {
+              return fmt::format("expected a finite number {} {}, found '{}'", inclusive ? "from" : "above", min, text);
+            }
+            return {};
+          },
+          fmt::format("NUMBER {} {}", inclusive ? ">=" : ">", min)};
 }
 
 Command add_eval_command(CLI::App& parent);

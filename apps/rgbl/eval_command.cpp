@@ -82,12 +82,12 @@ Command add_eval_command(CLI::App& parent) {
                   "KITTI segment lengths in metres, comma separated (default 100,...,800; for paths under 800 m up "
                   "to 8 round lengths below the path, as `rgbl run`)")
       ->delimiter(',')
-      ->check(CLI::PositiveNumber);
+      ->check(finite_number(0.0, false));
   app->add_option("--step", args->options.step, "Frames between segment starts (KITTI: 10)")
-      ->check(CLI::PositiveNumber)
+      ->check(whole_number(1))
       ->capture_default_str();
   app->add_option("--max-dt", args->options.max_time_difference, "TUM: largest timestamp difference to pair poses, s")
-      ->check(CLI::NonNegativeNumber)
+      ->check(finite_number(0.0, true))
       ->capture_default_str();
   app->add_option("--json", args->json, "Also write the results as JSON to this file ('-' for stdout)");
   return {app, [args] { return run_eval(*args); }};

@@ -39,6 +39,13 @@ expect("--frames: expected a whole number from 1 to 1000000000, found '184467440
 expect("--frames: expected a whole number from 1" run ${seq} --frames 0 --out ${WORK_DIR}/o)
 expect("--first: expected a whole number from 0" run ${seq} --first -1 --out ${WORK_DIR}/o)
 expect("--step: expected a whole number from 1 to 1000000000, found '0'" run ${seq} --step 0 --out ${WORK_DIR}/o)
+# eval's numeric options: no 309-digit range either
+expect("--step: expected a whole number from 1 to 1000000000, found '0'" eval ${WORK_DIR}/e.txt ${WORK_DIR}/g.txt
+       --step 0)
+expect("--lengths: expected a finite number above 0, found '0'" eval ${WORK_DIR}/e.txt ${WORK_DIR}/g.txt
+       --lengths 100,0)
+expect("--max-dt: expected a finite number from 0, found 'nan'" eval ${WORK_DIR}/e.txt ${WORK_DIR}/g.txt
+       --max-dt nan)
 
 # stereo on images no wider than SGBM's disparity range aborted inside OpenCV (SIGABRT)
 expect("^error: invalid option '--depth': expected stereo on images wider than its disparity range" run ${seq}
