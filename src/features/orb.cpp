@@ -1,6 +1,7 @@
 #include "rgbl/features/orb.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/task_pool.hpp"
 
 #include "fast.hpp"
 
@@ -168,7 +169,8 @@ OrbExtractor::OrbExtractor(const OrbOptions& options) : options_(options) {
   budgets_[static_cast<std::size_t>(levels) - 1] = std::max(0, options_.num_features - assigned);
 
   pattern_ = make_brief_pattern(options_.patch_size);
-  pattern_offsets_.resize(pattern_.size() * 2);
+  levels_.resize(static_cast<std::size_t>(levels));
+  for (auto& level : levels_) level.pattern_offsets.resize(pattern_.size() * 2);
   const int r = options_.orientation_radius;
   disc_half_width_.resize(static_cast<std::size_t>(r) + 1);
   for (int v = 0; v <= r; ++v) {
@@ -209,13 +211,17 @@ void OrbExtractor::build_pyramid(const cv::Mat& gray) {
 // FAST once over the level at the low threshold (scores kept), then per cell: the corners scoring
 // >= fast_threshold where the cell has any, else all of them (>= fast_min_threshold).
 void OrbExtractor::detect_level(int level) {
-  candidates_.clear();
+  Level& lv = levels_[static_cast<std::size_t>(level)];
+  auto& candidates = lv.candidates;
+  auto& fast = lv.fast;
+  auto& cell_strong = lv.cell_strong;
+  candidates.clear();
   const cv::Mat& img = pyramid_[static_cast<std::size_t>(level)];
   const int edge = options_.edge_threshold;
   const int width = img.cols - 2 * edge, height = img.rows - 2 * edge;  // where corners may lie
   if (img.empty() || width <= 0 || height <= 0) return;
-  detail::detect_fast(img, cv::Rect(edge, edge, width, height), options_.fast_min_threshold, fast_scores_, fast_);
-  if (fast_.empty()) return;
+  detail::detect_fast(img, cv::Rect(edge, edge, width, height), options_.fast_min_threshold, lv.fast_scores, fast);
+  if (fast.empty()) return;
 
   const int cols = std::max(1, width / options_.cell_size), rows = std::max(1, height / options_.cell_size);
   // Cell of a corner, by integer arithmetic: cells split the region as evenly as possible.
@@ -223,15 +229,15 @@ void OrbExtractor::detect_level(int level) {
     const int cx = (k.x - edge) * cols / width, cy = (k.y - edge) * rows / height;
     return static_cast<std::size_t>(cy * cols + cx);
   };
-  cell_strong_.assign(static_cast<std::size_t>(cols * rows), 0);
+  cell_strong.assign(static_cast<std::size_t>(cols * rows), 0);
   const int strong = options_.fast_threshold;
-  for (const auto& k : fast_) {
-    if (k.score >= strong) cell_strong_[cell_of(k)] = 1;
+  for (const auto& k : fast) {
+    if (k.score >= strong) cell_strong[cell_of(k)] = 1;
   }
-  candidates_.reserve(fast_.size());
-  for (const auto& k : fast_) {
-    if (k.score >= strong || cell_strong_[cell_of(k)] == 0) {
-      candidates_.push_back({static_cast<float>(k.x), static_cast<float>(k.y), static_cast<float>(k.score)});
+  candidates.reserve(fast.size());
+  for (const auto& k : fast) {
+    if (k.score >= strong || cell_strong[cell_of(k)] == 0) {
+      candidates.push_back({static_cast<float>(k.x), static_cast<float>(k.y), static_cast<float>(k.score)});
     }
   }
 }
@@ -240,12 +246,12 @@ void OrbExtractor::detect_level(int level) {
 // every node holds one corner; when a full round would overshoot, split the most populated nodes
 // first. Each node then contributes its per_node strongest corners (ties: by position), and if that
 // is more than `target` the strongest of them are kept.
-void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
+void OrbExtractor::distribute(int target, std::vector<Candidate>& candidates, std::vector<Candidate>& selected) {
   selected.clear();
-  if (candidates_.empty() || target <= 0) return;
-  const auto n = static_cast<int>(candidates_.size());
+  if (candidates.empty() || target <= 0) return;
+  const auto n = static_cast<int>(candidates.size());
   if (n <= target) {
-    selected.assign(candidates_.begin(), candidates_.end());
+    selected.assign(candidates.begin(), candidates.end());
     return;
   }
   // The quadtree places spread_fraction of the target, aiming at that / per_node nodes, each
@@ -254,8 +260,8 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
   const int spread_target = std::max(1, static_cast<int>(std::lround(options_.spread_fraction * target)));
   const int per_node = options_.features_per_node;
   const int target_nodes = (spread_target + per_node - 1) / per_node;
-  float min_x = candidates_[0].x, max_x = min_x, min_y = candidates_[0].y, max_y = min_y;
-  for (const auto& c : candidates_) {
+  float min_x = candidates[0].x, max_x = min_x, min_y = candidates[0].y, max_y = min_y;
+  for (const auto& c : candidates) {
     min_x = std::min(min_x, c.x);
     max_x = std::max(max_x, c.x);
     min_y = std::min(min_y, c.y);
@@ -274,14 +280,14 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
     };
     std::vector<int>& counts = root_counts_;
     counts.assign(static_cast<std::size_t>(roots) + 1, 0);
-    for (const auto& c : candidates_) ++counts[static_cast<std::size_t>(root_of(c)) + 1];
+    for (const auto& c : candidates) ++counts[static_cast<std::size_t>(root_of(c)) + 1];
     for (std::size_t r = 1; r < counts.size(); ++r) counts[r] += counts[r - 1];
-    bucketed_.resize(candidates_.size());
+    bucketed_.resize(candidates.size());
     std::vector<int> fill(counts.begin(), counts.end() - 1);
-    for (const auto& c : candidates_) {
+    for (const auto& c : candidates) {
       bucketed_[static_cast<std::size_t>(fill[static_cast<std::size_t>(root_of(c))]++)] = c;
     }
-    candidates_.swap(bucketed_);
+    candidates.swap(bucketed_);
     for (int r = 0; r < roots; ++r) {
       const int begin = counts[static_cast<std::size_t>(r)], end = counts[static_cast<std::size_t>(r) + 1];
       if (end > begin) {
@@ -295,12 +301,12 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
   };
   auto split = [&](const Node& node, std::vector<Node>& out) {
     const float xm = 0.5F * (node.x0 + node.x1), ym = 0.5F * (node.y0 + node.y1);
-    auto* first = candidates_.data() + node.begin;
-    auto* last = candidates_.data() + node.end;
+    auto* first = candidates.data() + node.begin;
+    auto* last = candidates.data() + node.end;
     auto* mid_y = std::partition(first, last, [ym](const Candidate& c) { return c.y < ym; });
     auto* mid_top = std::partition(first, mid_y, [xm](const Candidate& c) { return c.x < xm; });
     auto* mid_bottom = std::partition(mid_y, last, [xm](const Candidate& c) { return c.x < xm; });
-    const auto index = [&](const Candidate* p) { return static_cast<int>(p - candidates_.data()); };
+    const auto index = [&](const Candidate* p) { return static_cast<int>(p - candidates.data()); };
     const Node children[4] = {{node.x0, node.y0, xm, ym, index(first), index(mid_top)},
                               {xm, node.y0, node.x1, ym, index(mid_top), index(mid_y)},
                               {node.x0, ym, xm, node.y1, index(mid_y), index(mid_bottom)},
@@ -348,8 +354,8 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
   };
   selected.reserve(nodes_.size() * static_cast<std::size_t>(per_node));
   for (const Node& node : nodes_) {
-    auto* first = candidates_.data() + node.begin;
-    auto* last = candidates_.data() + node.end;
+    auto* first = candidates.data() + node.begin;
+    auto* last = candidates.data() + node.end;
     const int keep = std::min(per_node, node.end - node.begin);
     std::partial_sort(first, first + keep, last, stronger);
     selected.insert(selected.end(), first, first + keep);
@@ -367,23 +373,32 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& selected) {
   // everything behind each node's kept ones.
   for (const Node& node : nodes_) {
     const int keep = std::min(per_node, node.end - node.begin);
-    leftover_.insert(leftover_.end(), candidates_.begin() + node.begin + keep, candidates_.begin() + node.end);
+    leftover_.insert(leftover_.end(), candidates.begin() + node.begin + keep, candidates.begin() + node.end);
   }
   const auto take = std::min(static_cast<std::size_t>(rest), leftover_.size());
   std::partial_sort(leftover_.begin(), leftover_.begin() + static_cast<std::ptrdiff_t>(take), leftover_.end(), stronger);
   selected.insert(selected.end(), leftover_.begin(), leftover_.begin() + static_cast<std::ptrdiff_t>(take));
 }
 
-void OrbExtractor::describe_level(int level, std::span<const Candidate> selected, std::vector<Keypoint>& keypoints,
-                                  std::vector<Descriptor>& descriptors) {
+void OrbExtractor::describe_level(int level) {
+  Level& lv = levels_[static_cast<std::size_t>(level)];
+  const std::vector<Candidate>& selected = lv.selected;
+  std::vector<Keypoint>& keypoints = lv.keypoints;
+  std::vector<Descriptor>& descriptors = lv.descriptors;
+  std::vector<int>& offsets = lv.pattern_offsets;
+  cv::Mat& blurred = lv.blurred;
+  keypoints.clear();
+  descriptors.clear();
   if (selected.empty()) return;
+  keypoints.reserve(selected.size());
+  descriptors.reserve(selected.size());
   const cv::Mat& img = pyramid_[static_cast<std::size_t>(level)];
-  cv::GaussianBlur(img, blurred_, cv::Size(options_.blur_size, options_.blur_size), options_.blur_sigma,
+  cv::GaussianBlur(img, blurred, cv::Size(options_.blur_size, options_.blur_size), options_.blur_sigma,
                    options_.blur_sigma, cv::BORDER_REFLECT_101);
   const float scale = scales_[static_cast<std::size_t>(level)];
   const int r = options_.orientation_radius;
   const auto step = static_cast<int>(img.step1());
-  const auto blurred_step = static_cast<int>(blurred_.step1());
+  const auto blurred_step = static_cast<int>(blurred.step1());
   constexpr float kRadToDeg = 180.0F / 3.14159265358979323846F;
   constexpr float kDegToRad = 3.14159265358979323846F / 180.0F;
   const std::size_t pairs = pattern_.size();
@@ -421,17 +436,17 @@ void OrbExtractor::describe_level(int level, std::span<const Candidate> selected
     const float ca = std::cos(angle * kDegToRad), sa = std::sin(angle * kDegToRad);
     for (std::size_t i = 0; i < pairs; ++i) {
       const BriefPair& p = pattern_[i];
-      pattern_offsets_[2 * i] = round_to_int(p.x1 * sa + p.y1 * ca) * blurred_step + round_to_int(p.x1 * ca - p.y1 * sa);
-      pattern_offsets_[2 * i + 1] =
+      offsets[2 * i] = round_to_int(p.x1 * sa + p.y1 * ca) * blurred_step + round_to_int(p.x1 * ca - p.y1 * sa);
+      offsets[2 * i + 1] =
           round_to_int(p.x2 * sa + p.y2 * ca) * blurred_step + round_to_int(p.x2 * ca - p.y2 * sa);
     }
-    const std::uint8_t* bc = blurred_.ptr<std::uint8_t>(cy) + cx;
+    const std::uint8_t* bc = blurred.ptr<std::uint8_t>(cy) + cx;
     Descriptor d{};
     for (std::size_t byte = 0; byte < 32; ++byte) {
       unsigned bits = 0;
       for (std::size_t bit = 0; bit < 8; ++bit) {
         const std::size_t i = byte * 8 + bit;
-        bits |= static_cast<unsigned>(bc[pattern_offsets_[2 * i]] < bc[pattern_offsets_[2 * i + 1]]) << bit;
+        bits |= static_cast<unsigned>(bc[offsets[2 * i]] < bc[offsets[2 * i + 1]]) << bit;
       }
       d[byte] = static_cast<std::uint8_t>(bits);
     }
@@ -448,20 +463,32 @@ void OrbExtractor::describe_level(int level, std::span<const Candidate> selected
 }
 
 void OrbExtractor::extract(const cv::Mat& gray, std::vector<Keypoint>& keypoints,
-                           std::vector<Descriptor>& descriptors) {
+                           std::vector<Descriptor>& descriptors, TaskPool* pool) {
   require(!gray.empty() && gray.type() == CV_8UC1, "orb.image", "a non-empty 8-bit single-channel image");
   keypoints.clear();
   descriptors.clear();
   keypoints.reserve(static_cast<std::size_t>(options_.num_features));
   descriptors.reserve(static_cast<std::size_t>(options_.num_features));
   build_pyramid(gray);
+  const auto levels = static_cast<std::size_t>(options_.num_levels);
+  const auto each_level = [&](auto&& fn) {
+    if (pool != nullptr && pool->threads() > 1) {
+      pool->parallel_for(levels, [&](std::size_t l) { fn(static_cast<int>(l)); });
+    } else {
+      for (std::size_t l = 0; l < levels; ++l) fn(static_cast<int>(l));
+    }
+  };
+  each_level([this](int l) { detect_level(l); });
   int carry = 0;  // a level's unused budget goes to the next one
-  for (int l = 0; l < options_.num_levels; ++l) {
-    const int target = budgets_[static_cast<std::size_t>(l)] + carry;
-    detect_level(l);
-    distribute(target, selected_);
-    carry = target - static_cast<int>(selected_.size());
-    describe_level(l, selected_, keypoints, descriptors);
+  for (std::size_t l = 0; l < levels; ++l) {
+    const int target = budgets_[l] + carry;
+    distribute(target, levels_[l].candidates, levels_[l].selected);
+    carry = target - static_cast<int>(levels_[l].selected.size());
+  }
+  each_level([this](int l) { describe_level(l); });
+  for (const Level& lv : levels_) {
+    keypoints.insert(keypoints.end(), lv.keypoints.begin(), lv.keypoints.end());
+    descriptors.insert(descriptors.end(), lv.descriptors.begin(), lv.descriptors.end());
   }
 }
 

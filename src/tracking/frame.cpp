@@ -9,10 +9,10 @@
 
 namespace rgbl {
 
-FeatureExtractor make_orb_extractor(const OrbOptions& options) {
+FeatureExtractor make_orb_extractor(const OrbOptions& options, std::shared_ptr<TaskPool> pool) {
   auto extractor = std::make_shared<OrbExtractor>(options);
-  return [extractor](const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors) {
-    extractor->extract(gray, keypoints, descriptors);
+  return [extractor, pool](const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors) {
+    extractor->extract(gray, keypoints, descriptors, pool.get());
   };
 }
 

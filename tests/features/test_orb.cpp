@@ -1,5 +1,6 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/features/matcher.hpp"
+#include "rgbl/core/task_pool.hpp"
 #include "rgbl/features/orb.hpp"
 #include "src/features/fast.hpp"
 #include "support/data.hpp"
@@ -246,6 +247,30 @@ TEST_CASE("ORB: deterministic, same image gives identical keypoints and descript
       REQUIRE(k.response == a.keypoints[i].response);
       REQUIRE(k.level == a.keypoints[i].level);
       REQUIRE(other->descriptors[i] == a.descriptors[i]);
+    }
+  }
+}
+
+TEST_CASE("ORB: levels on a pool's threads give the same features, bit for bit", "[features][orb]") {
+  std::vector<cv::Mat> images{textured_image(1226, 370), textured_image(613, 185, 5)};
+  if (const auto real = kitti_frame(10)) images.push_back(*real);
+  for (const cv::Mat& img : images) {
+    const Extracted serial = extract(img);
+    REQUIRE(serial.keypoints.size() > 500);
+    for (const int threads : {2, 3, 8}) {
+      rgbl::TaskPool pool(threads);
+      rgbl::OrbExtractor extractor;
+      Extracted pooled;
+      for (int repeat = 0; repeat < 2; ++repeat) {  // buffers reused on the second call
+        extractor.extract(img, pooled.keypoints, pooled.descriptors, &pool);
+        REQUIRE(pooled.keypoints.size() == serial.keypoints.size());
+        for (std::size_t i = 0; i < serial.keypoints.size(); ++i) {
+          const auto& a = serial.keypoints[i];
+          const auto& b = pooled.keypoints[i];
+          REQUIRE((a.x == b.x && a.y == b.y && a.angle == b.angle && a.response == b.response && a.level == b.level));
+          REQUIRE(pooled.descriptors[i] == serial.descriptors[i]);
+        }
+      }
     }
   }
 }

@@ -15,6 +15,8 @@
 
 namespace rgbl {
 
+class TaskPool;
+
 namespace detail {
 // A FAST corner in level pixels; score = largest threshold at which it is a corner.
 struct FastCorner {
@@ -76,8 +78,11 @@ class OrbExtractor {
   ~OrbExtractor() = default;
 
   // `gray`: CV_8UC1. Clears and fills `keypoints` (level-0 pixel coordinates) and `descriptors` (same
-  // length and order). Ordered by level, then by position within the level's quadtree. Deterministic.
-  void extract(const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors);
+  // length and order). Ordered by level, then by position within the level's quadtree. Deterministic:
+  // with a pool, detection and description run level by level on its threads and give the same
+  // keypoints and descriptors, bit for bit, as without.
+  void extract(const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors,
+               TaskPool* pool = nullptr);
 
   const OrbOptions& options() const noexcept { return options_; }
   // scale_factor^level for every level: multiply a level's pixel coordinates by it to get level 0.
@@ -96,11 +101,23 @@ class OrbExtractor {
     float x0, y0, x1, y1;
     int begin, end;  // range in candidates_
   };
+  // What one level's detection and description use and produce: levels run independently.
+  struct Level {
+    std::vector<detail::FastCorner> fast;
+    std::vector<std::uint8_t> fast_scores;
+    std::vector<unsigned char> cell_strong;
+    std::vector<Candidate> candidates;
+    std::vector<Candidate> selected;
+    cv::Mat blurred;
+    std::vector<int> pattern_offsets;
+    std::vector<Keypoint> keypoints;
+    std::vector<Descriptor> descriptors;
+  };
   void build_pyramid(const cv::Mat& gray);
   void detect_level(int level);
-  void distribute(int target, std::vector<Candidate>& selected);
-  void describe_level(int level, std::span<const Candidate> selected, std::vector<Keypoint>& keypoints,
-                      std::vector<Descriptor>& descriptors);
+  // Sequential over levels: a level's unused budget moves to the next.
+  void distribute(int target, std::vector<Candidate>& candidates, std::vector<Candidate>& selected);
+  void describe_level(int level);
 
   OrbOptions options_;
   std::vector<float> scales_;
@@ -110,17 +127,11 @@ class OrbExtractor {
   std::vector<std::uint8_t> disc_masks_;  // the same disc as 32-byte row masks for the SIMD path
   // Scratch reused across calls.
   std::vector<cv::Mat> pyramid_;
-  cv::Mat blurred_;
-  std::vector<detail::FastCorner> fast_;
-  std::vector<std::uint8_t> fast_scores_;
+  std::vector<Level> levels_;
   std::vector<int> root_counts_;
   std::vector<Candidate> bucketed_;
   std::vector<Candidate> leftover_;  // corners the quadtree did not take
-  std::vector<Candidate> candidates_;
-  std::vector<Candidate> selected_;
   std::vector<Node> nodes_, next_nodes_;
-  std::vector<unsigned char> cell_strong_;
-  std::vector<int> pattern_offsets_;
 };
 
 }  // namespace rgbl

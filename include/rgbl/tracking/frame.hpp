@@ -3,6 +3,7 @@
 
 #include "rgbl/features/matcher.hpp"
 #include "rgbl/features/orb.hpp"
+#include "rgbl/core/task_pool.hpp"
 #include "rgbl/features/types.hpp"
 #include "rgbl/map/map.hpp"
 
@@ -10,6 +11,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -22,8 +24,10 @@ namespace rgbl {
 using FeatureExtractor =
     std::function<void(const cv::Mat& gray, std::vector<Keypoint>& keypoints, std::vector<Descriptor>& descriptors)>;
 
-// rgbl's ORB extractor (rgbl/features/orb.hpp) as a FeatureExtractor; copies share one extractor.
-FeatureExtractor make_orb_extractor(const OrbOptions& options);
+// rgbl's ORB extractor (rgbl/features/orb.hpp) as a FeatureExtractor; copies share one extractor (so
+// one call at a time). With a pool, pyramid levels are detected and described on its threads (the
+// same features, bit for bit).
+FeatureExtractor make_orb_extractor(const OrbOptions& options, std::shared_ptr<TaskPool> pool = nullptr);
 
 struct Frame {
   std::size_t index = 0;

@@ -1,0 +1,73 @@
+#include "rgbl/tracking/frame_builder.hpp"
+
+#include "rgbl/core/error.hpp"
+#include "rgbl/core/timer.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+namespace rgbl {
+
+FrameBuilder::FrameBuilder(const CameraCalibration& calibration, const DepthNoiseModel& noise,
+                           std::unique_ptr<DepthSource> depth, FeatureExtractor extractor,
+                           std::shared_ptr<TaskPool> pool)
+    : calibration_(calibration), noise_(noise), depth_(std::move(depth)), extractor_(std::move(extractor)),
+      pool_(std::move(pool)) {
+  if (!depth_) throw ConfigError("depth", "a depth source");
+  if (!extractor_) throw ConfigError("extractor", "a feature extractor");
+}
+
+PreparedFrame FrameBuilder::build(const SensorFrame& sensor) {
+  Stopwatch wall;
+  PreparedFrame out;
+  Frame& frame = out.frame;
+  frame.index = sensor.index;
+  frame.timestamp = sensor.timestamp;
+
+  double prepare_ms = 0.0;
+  const auto prepare = [&] {
+    Stopwatch t;
+    depth_->prepare(sensor);
+    prepare_ms = t.elapsed_ms();
+  };
+  // the preparation beside extraction when there is a second thread; its exception after both
+  TaskPool::Task prepared;
+  if (pool_ && pool_->threads() > 1) {
+    prepared = pool_->submit(prepare);
+  } else {
+    prepare();
+  }
+
+  Stopwatch extraction;
+  // A grey input is used in place, never kept in gray_: a later colour frame of the same size would
+  // be converted into the caller's (by then perhaps freed) buffer.
+  const cv::Mat* gray = &sensor.image;
+  if (sensor.image.channels() == 3) {
+    cv::cvtColor(sensor.image, gray_, cv::COLOR_BGR2GRAY);
+    gray = &gray_;
+  }
+  extractor_(*gray, frame.keypoints, frame.descriptors);
+  out.extraction_ms = extraction.elapsed_ms();
+  prepared.wait();
+
+  Stopwatch sampling;
+  const std::size_t n = frame.keypoints.size();
+  pixels_.resize(n);
+  depths_.assign(n, KeypointDepth{});
+  for (std::size_t i = 0; i < n; ++i) pixels_[i] = Eigen::Vector2f(frame.keypoints[i].x, frame.keypoints[i].y);
+  depth_->sample(pixels_, depths_);
+  frame.depth.resize(n);
+  frame.depth_sigma.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const KeypointDepth& d = depths_[i];
+    const double sigma = d.z > 0.0F ? noise_.sigma(d.z, d.sample_distance_px, d.spread, calibration_.camera.fx) : 0.0;
+    frame.depth[i] = sigma > 0.0 ? d.z : 0.0F;
+    frame.depth_sigma[i] = static_cast<float>(sigma);
+    out.keypoints_with_depth += sigma > 0.0 ? 1 : 0;
+  }
+  frame.build_grid(calibration_.camera.width, calibration_.camera.height);
+  out.depth_ms = prepare_ms + sampling.elapsed_ms();
+  out.critical_ms = wall.elapsed_ms();
+  return out;
+}
+
+}  // namespace rgbl
