@@ -1,4 +1,4 @@
-// rgbl run <dir> [input options] [--out <dir>] [--threaded] [--no-loop-closing]
+// rgbl run <dir> [input options] [--out <dir>] [--threads N] [--threaded] [--no-loop-closing]
 #include "command.hpp"
 #include "input_options.hpp"
 
@@ -14,6 +14,11 @@ Command add_run_command(CLI::App& parent) {
   auto no_loop_closing = std::make_shared<bool>(false);
   add_input_options(*app, *options);
   app->add_option("--out", *out_dir, "Output folder")->capture_default_str();
+  app->add_option("--threads", options->threads,
+                  "Threads for each frame's work: with 2 or more the next frame is built while this one is tracked "
+                  "(the same trajectory for every count; default 0: the machine's hardware threads)")
+      ->check(whole_number(0, 256))
+      ->capture_default_str();
   app->add_flag("--threaded", options->threaded,
                 "Local mapping and loop closing in threads of their own (default: inline, bit-for-bit reproducible)");
   app->add_flag("--no-loop-closing", *no_loop_closing,

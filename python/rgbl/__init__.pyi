@@ -293,6 +293,7 @@ class StageTiming:
     tracking_ms: float
     mapping_ms: float
     loop_ms: float
+    front_ms: float
     total_ms: float
 
 class LoopClosure:
@@ -317,6 +318,8 @@ class TrackResult:
     inliers: int
     keypoints: int
     keypoints_with_depth: int
+    map_keyframes: int
+    map_landmarks: int
     loop_closure: Optional[LoopClosure]
     timing: StageTiming
     @property
@@ -364,6 +367,7 @@ class PipelineOptions:
     depth: str
     settings: os.PathLike[str]
     threaded: bool
+    threads: int
     loop_closing: bool
     def __init__(self) -> None: ...
 
@@ -403,6 +407,7 @@ class RunResult:
     first: int
     step: int
     threaded: bool
+    threads: int
     loop_closing: bool
     frames: list[FrameRecord]
     loop_closures: list[LoopClosure]
@@ -432,7 +437,8 @@ class Pipeline:
     """What `rgbl run` does: Pipeline(dataset, ...).run(progress) -> RunResult."""
     def __init__(self, dataset: Union[_Path, PipelineOptions], *, format: str = "auto", camera: int = -1,
                  first: int = 0, frames: int = 0, step: int = 1, depth: str = "lidar",
-                 settings: Optional[_Path] = None, threaded: bool = False, loop_closing: bool = True) -> None: ...
+                 settings: Optional[_Path] = None, threaded: bool = False, loop_closing: bool = True,
+                 threads: int = 0) -> None: ...
     @property
     def options(self) -> PipelineOptions: ...
     @property

@@ -73,7 +73,8 @@ void bind_tracking(py::module_& m) {
       .def_readonly("tracking_ms", &StageTiming::tracking_ms)
       .def_readonly("mapping_ms", &StageTiming::mapping_ms, "Inline local mapping (0 when threaded).")
       .def_readonly("loop_ms", &StageTiming::loop_ms)
-      .def_readonly("total_ms", &StageTiming::total_ms, "The whole System.track call in C++.");
+      .def_readonly("front_ms", &StageTiming::front_ms, "Wall, from the frame's turn to its pose.")
+      .def_readonly("total_ms", &StageTiming::total_ms, "Wall, the frame's whole turn (building it included).");
 
   py::class_<LoopClosure>(m, "LoopClosure", "A loop closed: the map was corrected.")
       .def_readonly("frame_index", &LoopClosure::frame_index, "Of the keyframe that closed it.")
@@ -99,6 +100,8 @@ void bind_tracking(py::module_& m) {
       .def_readonly("inliers", &TrackResult::inliers, "Local-map inliers (Ok needs 30).")
       .def_readonly("keypoints", &TrackResult::keypoints)
       .def_readonly("keypoints_with_depth", &TrackResult::keypoints_with_depth)
+      .def_readonly("map_keyframes", &TrackResult::map_keyframes, "The map's keyframes after this frame.")
+      .def_readonly("map_landmarks", &TrackResult::map_landmarks, "The map's landmarks after this frame.")
       .def_readonly("loop_closure", &TrackResult::loop_closure, "A LoopClosure or None.")
       .def_readonly("timing", &TrackResult::timing)
       .def("__repr__", [](const TrackResult& r) {

@@ -74,13 +74,13 @@ void write_text(const std::filesystem::path& file, const std::string& text) {
 std::string timing_csv(const RunResult& run) {
   std::string csv =
       "frame,timestamp,state,keyframe,keypoints,keypoints_with_depth,inliers,io_wait_ms,depth_ms,"
-      "extraction_ms,tracking_ms,mapping_ms,loop_ms,total_ms\n";
+      "extraction_ms,tracking_ms,mapping_ms,loop_ms,front_ms,total_ms\n";
   for (const auto& r : run.frames) {
     const auto& t = r.result.timing;
-    csv += fmt::format("{},{:.6f},{},{},{},{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f}\n",
+    csv += fmt::format("{},{:.6f},{},{},{},{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f}\n",
                        r.result.frame_index, r.result.timestamp, to_string(r.result.state), r.result.keyframe ? 1 : 0,
                        r.result.keypoints, r.result.keypoints_with_depth, r.result.inliers, r.io_wait_ms,
-                       t.depth_ms, t.extraction_ms, t.tracking_ms, t.mapping_ms, t.loop_ms, t.total_ms);
+                       t.depth_ms, t.extraction_ms, t.tracking_ms, t.mapping_ms, t.loop_ms, t.front_ms, t.total_ms);
   }
   return csv;
 }
@@ -170,6 +170,7 @@ std::string summary_json(const RunResult& run) {
                           {"implausible", l.implausible}, {"consistent", l.consistent}, {"confirming", l.confirming},
                           {"closures", l.closures},     {"merges", l.merges},         {"time_ms", number(l.time_ms)}};
   j["threaded_mapping"] = run.threaded;
+  j["threads"] = run.threads;
   j["wall_s"] = number(run.wall_s);
   j["stage_ms"] = {{"io_wait", stage(t.io_wait)},
                    {"depth", stage(t.depth)},

@@ -1,6 +1,7 @@
 #include "rgbl/pipeline/pipeline.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/task_pool.hpp"
 #include "rgbl/core/timer.hpp"
 #include "rgbl/depth/sources.hpp"
 #include "rgbl/io/settings.hpp"
@@ -8,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <mutex>
@@ -88,12 +90,28 @@ void PipelineOptions::validate() const {
   }
   if (step < 1) throw ConfigError("step", "a stride of at least 1 frame");
   if (depth.empty()) throw ConfigError("depth", "a depth source name (lidar, precomputed:<dir>, stereo, ...)");
+  if (threads < 0 || threads > 256) {
+    throw ConfigError("threads", fmt::format("0 (the machine's hardware threads) or a count from 1 to 256, not {}", threads));
+  }
 }
 
+namespace {
+std::unique_ptr<Sequence> open_validated(const PipelineOptions& options) {
+  options.validate();
+  return open_sequence(options.dataset, options.format);
+}
+}  // namespace
+
 Pipeline::Pipeline(const PipelineOptions& options, const DepthSourceRegistry& registry)
-    : options_(options), registry_(registry) {
+    : Pipeline(open_validated(options), options, registry) {}
+
+Pipeline::Pipeline(std::unique_ptr<Sequence> sequence, const PipelineOptions& options,
+                   const DepthSourceRegistry& registry)
+    : options_(options), sequence_(std::move(sequence)), registry_(registry) {
+  if (!sequence_) throw ConfigError("sequence", "an opened sequence");
+  options_.dataset = sequence_->path();
+  options_.format = sequence_->format();
   options_.validate();
-  sequence_ = open_sequence(options_.dataset, options_.format);
   const auto& sensors = sequence_->sensors();
   // The tracker works on grey images: a native grey camera (0) is the default, the colour camera (2)
   // is converted per frame.
@@ -120,6 +138,7 @@ Pipeline::Pipeline(const PipelineOptions& options, const DepthSourceRegistry& re
     registry_.add("rgbd", rgbd_depth_source(rgbd));
   }
   system_.threaded_mapping = options_.threaded;
+  threads_ = options_.threads > 0 ? options_.threads : TaskPool::hardware_threads();
   if (!options_.loop_closing) system_.loop_closing.enabled = false;
 
   // the dataset must have what the source reads, before any frame is read
@@ -176,6 +195,17 @@ std::unique_ptr<System> Pipeline::make_system() const {
   return std::make_unique<System>(system_, context_.calibration, make_depth_source(), make_extractor());
 }
 
+namespace {
+// A frame on its way: the loaded input (which the sensor frame views) and its build.
+struct InFlight {
+  FrameInput input;
+  SensorFrame sensor;
+  PreparedFrame prepared;
+  double io_wait_ms = 0.0;
+  TaskPool::Task build;  // last: destroyed (waited for) before what it writes to
+};
+}  // namespace
+
 RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
   const std::unique_ptr<System> system = make_system();
   ReadAhead frames(*sequence_, read_ahead_options());
@@ -183,20 +213,63 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
   records.reserve(count_);
   Stopwatch wall;
   bool stopped = false;
-  for (;;) {
-    if (stop.stop_requested()) {
-      stopped = records.size() < count_;
-      break;
-    }
-    Stopwatch wait;
-    std::optional<FrameInput> input = frames.next();
-    const double wait_ms = wait.elapsed_ms();
-    if (!input) break;
-    FrameRecord record;
-    record.result = system->track(sensor_frame(*input));
-    record.io_wait_ms = wait_ms;
-    records.push_back(record);
+  const auto add = [&](FrameRecord record) {
+    records.push_back(std::move(record));
     if (progress) progress(records.back(), records.size(), count_);
+  };
+  if (threads_ <= 1) {
+    for (;;) {
+      if (stop.stop_requested()) {
+        stopped = records.size() < count_;
+        break;
+      }
+      Stopwatch wait;
+      std::optional<FrameInput> input = frames.next();
+      const double wait_ms = wait.elapsed_ms();
+      if (!input) break;
+      FrameRecord record;
+      record.result = system->track(sensor_frame(*input));
+      record.io_wait_ms = wait_ms;
+      add(std::move(record));
+    }
+  } else {
+    // Frame i + 1 is built (on the pool, its levels spread over every thread) while frame i is
+    // tracked here; two builders, as each depth source holds the frame it prepared. A build is a
+    // function of its frame alone, so the trajectory is the one of a single thread.
+    const auto pool = std::make_shared<TaskPool>(threads_);
+    std::array<FrameBuilder, 2> builders{
+        FrameBuilder(context_.calibration, system_.depth_noise, make_depth_source(), make_orb_extractor(orb_, pool), pool),
+        FrameBuilder(context_.calibration, system_.depth_noise, make_depth_source(), make_orb_extractor(orb_, pool), pool)};
+    std::size_t started = 0;
+    const auto start = [&]() -> std::unique_ptr<InFlight> {
+      Stopwatch wait;
+      std::optional<FrameInput> input = frames.next();
+      if (!input) return nullptr;
+      auto f = std::make_unique<InFlight>();
+      f->io_wait_ms = wait.elapsed_ms();
+      f->input = std::move(*input);
+      f->sensor = sensor_frame(f->input);
+      FrameBuilder& builder = builders[started++ % 2];
+      f->build = pool->submit([&builder, f = f.get()] { f->prepared = builder.build(f->sensor); });
+      return f;
+    };
+    std::unique_ptr<InFlight> next = start();
+    while (next) {
+      if (stop.stop_requested()) {
+        stopped = records.size() < count_;
+        break;
+      }
+      const std::unique_ptr<InFlight> current = std::move(next);
+      Stopwatch wait;
+      current->build.wait();  // helps with its levels meanwhile; rethrows what loading or building threw
+      current->prepared.critical_ms = wait.elapsed_ms();
+      if (!stop.stop_requested()) next = start();  // overlaps the tracking below
+      FrameRecord record;
+      record.result = system->track(current->sensor, std::move(current->prepared));
+      record.io_wait_ms = current->io_wait_ms;
+      add(std::move(record));
+    }
+    stopped = stop.stop_requested() && records.size() < count_;
   }
   system->finish();
   RunResult out = collect(*system, std::move(records), wall.elapsed_ms() / 1000.0);
@@ -214,6 +287,7 @@ RunResult Pipeline::collect(System& system, std::vector<FrameRecord> frames, dou
   out.depth = depth_name_;
   out.first = options_.first;
   out.step = options_.step;
+  out.threads = threads_;
   out.threaded = system_.threaded_mapping;
   out.frames = std::move(frames);
   out.frames_planned = count_;
@@ -324,10 +398,7 @@ RunTimings RunResult::timings() const {
   t.tracking = stage([](const FrameRecord& r) { return r.result.timing.tracking_ms; });
   t.mapping = stage([](const FrameRecord& r) { return r.result.timing.mapping_ms; });
   t.loop = stage([](const FrameRecord& r) { return r.result.timing.loop_ms; });
-  t.front = stage([](const FrameRecord& r) {
-    const auto& s = r.result.timing;
-    return s.depth_ms + s.extraction_ms + s.tracking_ms;
-  });
+  t.front = stage([](const FrameRecord& r) { return r.result.timing.front_ms; });
   t.total = stage([](const FrameRecord& r) { return r.result.timing.total_ms; });
   return t;
 }

@@ -91,16 +91,12 @@ class WorkQueue {
 struct System::Impl {
   SystemOptions options;
   CameraCalibration calibration;
-  std::unique_ptr<DepthSource> depth;
-  FeatureExtractor extractor;
   Map map;
   Tracker tracker;
   LocalMapper mapper;
   LoopCloser closer;
+  FrameBuilder builder;  // for track(SensorFrame): the depth source and the extractor
   std::vector<FrameRecord> records;
-  std::vector<Eigen::Vector2f> pixels;
-  std::vector<KeypointDepth> depths;
-  cv::Mat gray;
 
   std::vector<LoopClosure> closures;  // every closure so far (threaded: guarded by results_mutex)
 
@@ -123,8 +119,8 @@ struct System::Impl {
   LoopClosingStats stats;            // the loop thread's, after its last keyframe
 
   Impl(SystemOptions o, CameraCalibration c, std::unique_ptr<DepthSource> d, FeatureExtractor e)
-      : options(o), calibration(c), depth(std::move(d)), extractor(std::move(e)), map(o.map),
-        tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping), closer(c.camera, o.loop_closing) {
+      : options(o), calibration(c), map(o.map), tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping),
+        closer(c.camera, o.loop_closing), builder(c, o.depth_noise, std::move(d), std::move(e)) {
     if (threaded_loop_closing()) loop_thread = std::thread([this] { run_loop_closing(); });
     if (options.threaded_mapping) mapping_thread = std::thread([this] { run_mapping(); });
   }
@@ -214,51 +210,22 @@ void System::finish() {
   impl_->loop_queue.wait_idle();  // mapping has handed over its last keyframe
 }
 
-TrackResult System::track(const SensorFrame& sensor) {
+TrackResult System::track(const SensorFrame& sensor) { return track(sensor, impl_->builder.build(sensor)); }
+
+TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   Impl& s = *impl_;
   TrackResult result;
   result.frame_index = sensor.index;
   result.timestamp = sensor.timestamp;
   Stopwatch total, stage;
-
-  s.depth->prepare(sensor);
-  result.timing.depth_ms = stage.lap_ms();
-
-  // A grey input is used in place, never kept in s.gray: a later colour frame of the same size would
-  // be converted into the caller's (by then perhaps freed) buffer.
-  const cv::Mat* gray = &sensor.image;
-  if (sensor.image.channels() == 3) {
-    cv::cvtColor(sensor.image, s.gray, cv::COLOR_BGR2GRAY);
-    gray = &s.gray;
-  }
-  Frame frame;
-  frame.index = sensor.index;
-  frame.timestamp = sensor.timestamp;
-  s.extractor(*gray, frame.keypoints, frame.descriptors);
-  result.timing.extraction_ms = stage.lap_ms();
-
-  const std::size_t n = frame.keypoints.size();
-  s.pixels.resize(n);
-  s.depths.assign(n, KeypointDepth{});
-  for (std::size_t i = 0; i < n; ++i) s.pixels[i] = Eigen::Vector2f(frame.keypoints[i].x, frame.keypoints[i].y);
-  s.depth->sample(s.pixels, s.depths);
-  frame.depth.resize(n);
-  frame.depth_sigma.resize(n);
-  int with_depth = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const KeypointDepth& d = s.depths[i];
-    const double sigma = d.z > 0.0F ? s.options.depth_noise.sigma(d.z, d.sample_distance_px, d.spread,
-                                                                   s.calibration.camera.fx)
-                                    : 0.0;
-    frame.depth[i] = sigma > 0.0 ? d.z : 0.0F;
-    frame.depth_sigma[i] = static_cast<float>(sigma);
-    with_depth += sigma > 0.0 ? 1 : 0;
-  }
+  Frame& frame = prepared.frame;
+  const std::size_t n = frame.size();
+  const int with_depth = prepared.keypoints_with_depth;
+  result.timing.extraction_ms = prepared.extraction_ms;
   if (s.options.lidar_scan_period > 0.0 && has_pose(s.tracker.state()) && s.tracker.velocity()) {
     s.compensate_lidar_motion(frame);
   }
-  frame.build_grid(s.calibration.camera.width, s.calibration.camera.height);
-  result.timing.depth_ms += stage.lap_ms();
+  result.timing.depth_ms = prepared.depth_ms + stage.lap_ms();
 
   // A loop thread's correction waits for this frame to be tracked and recorded (uncontended inline).
   const std::lock_guard gate(s.tracking_gate);
@@ -266,6 +233,7 @@ TrackResult System::track(const SensorFrame& sensor) {
   KeyframeId new_keyframe;
   if (outcome.need_keyframe) new_keyframe = s.tracker.make_keyframe(frame);
   result.timing.tracking_ms = stage.lap_ms();
+  result.timing.front_ms = prepared.critical_ms + total.elapsed_ms();
 
   const auto scan_copy = [&] {
     return s.threaded_loop_closing() ? std::vector<LidarPoint>(sensor.scan.begin(), sensor.scan.end())
@@ -324,6 +292,8 @@ TrackResult System::track(const SensorFrame& sensor) {
   {
     std::shared_lock lock(s.map.mutex());
     record.reference = s.tracker.reference_keyframe();
+    result.map_keyframes = s.map.keyframe_count();
+    result.map_landmarks = s.map.landmark_count();
     if (const auto T_ref_world = s.map.keyframe_pose(record.reference)) {
       record.T_cam_reference = frame.T_cam_world * T_ref_world->inverse();
     } else {
@@ -332,7 +302,7 @@ TrackResult System::track(const SensorFrame& sensor) {
     }
   }
   s.records.push_back(record);
-  result.timing.total_ms = total.elapsed_ms();
+  result.timing.total_ms = prepared.critical_ms + total.elapsed_ms();
   return result;
 }
 

@@ -1,5 +1,6 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/file.hpp"
+#include "rgbl/core/task_pool.hpp"
 #include "rgbl/pipeline/pipeline.hpp"
 #include "rgbl/sim/synthetic.hpp"
 #include "support/data.hpp"
@@ -143,6 +144,56 @@ TEST_CASE("KITTI 04 at 2.5 Hz: the second frame is placed from both starts and r
   CHECK(step == Approx(true_step).margin(0.2));
 }
 
+namespace {
+// The same run with 1, 2 and 3 frame threads: every pose, state and inlier count equal to the bit.
+void check_thread_counts_agree(rgbl::PipelineOptions o) {
+  o.threads = 1;
+  const rgbl::RunResult serial = rgbl::Pipeline(o).run();
+  CHECK(serial.threads == 1);
+  REQUIRE(serial.frames.size() >= 10);
+  for (const int threads : {2, 3}) {
+    o.threads = threads;
+    const rgbl::RunResult run = rgbl::Pipeline(o).run();
+    CHECK(run.threads == threads);
+    REQUIRE(run.frames.size() == serial.frames.size());
+    for (std::size_t i = 0; i < serial.frames.size(); ++i) {
+      const auto& a = serial.frames[i].result;
+      const auto& b = run.frames[i].result;
+      INFO("frame " << a.frame_index << ", " << threads << " threads");
+      CHECK(b.state == a.state);
+      CHECK(b.inliers == a.inliers);
+      CHECK(b.keypoints_with_depth == a.keypoints_with_depth);
+      CHECK(b.keyframe == a.keyframe);
+      CHECK(run.trajectory.poses[i].matrix() == serial.trajectory.poses[i].matrix());
+    }
+    CHECK(run.landmarks.size() == serial.landmarks.size());
+    // the frame's critical path shrinks, its stages do not vanish
+    CHECK(run.timings().front.median > 0.0);
+    CHECK(run.timings().extraction.median > 0.0);
+  }
+}
+}  // namespace
+
+TEST_CASE("frame threads: the same trajectory for 1, 2 and 3 threads (synthetic curve)") {
+  auto o = options();
+  o.frames = 24;
+  check_thread_counts_agree(o);
+  // 0 means the machine's threads; out-of-range counts are refused naming the option
+  o.threads = 0;
+  CHECK(rgbl::Pipeline(o).threads() == rgbl::TaskPool::hardware_threads());
+  o.threads = -1;
+  CHECK_THROWS_WITH(rgbl::Pipeline(o), Contains("threads") && Contains("from 1 to 256"));
+}
+
+TEST_CASE("frame threads: the same trajectory for 1, 2 and 3 threads (KITTI 04, frames 0-29)") {
+  const auto seq = rgbl::test::kitti_seq04();
+  if (!seq) return;
+  rgbl::PipelineOptions o;
+  o.dataset = *seq;
+  o.frames = 30;
+  check_thread_counts_agree(o);
+}
+
 TEST_CASE("a pipeline refuses bad options and data it cannot use before the first frame, naming them") {
   auto o = options();
   o.camera = 1;
@@ -188,7 +239,8 @@ TEST_CASE("a pipeline creates a user's depth source by name and checks what it n
   const rgbl::Pipeline pipeline(o, sources);
   CHECK(created == 1);  // once at construction: its options are checked before any frame
   const rgbl::RunResult run = pipeline.run();
-  CHECK(created == 2);
+  // the System's own, and with frame threads one for each of the two frames in flight
+  CHECK(created == (pipeline.threads() > 1 ? 4 : 2));
   CHECK(run.depth == "far_lidar");
   CHECK(run.count(rgbl::TrackState::Ok) == 10);
 

@@ -7,6 +7,7 @@
 #include "loop/sim_frames.hpp"
 
 #include "rgbl/eval/trajectory_metrics.hpp"
+#include "rgbl/pipeline/pipeline.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -93,4 +94,21 @@ TEST_CASE("threaded loop closing: the two laps are closed in the loop thread and
     CHECK((truth[c.frame_index].translation() - truth[c.matched_frame_index].translation()).norm() < 10.0);
   }
   CHECK(ate < 0.3);
+}
+
+TEST_CASE("frame threads: frames built ahead on a pool, the same poses as one thread (seq 04)") {
+  const auto sequence = rgbl::test::kitti_seq04();
+  if (!sequence) return;
+  rgbl::PipelineOptions o;
+  o.dataset = *sequence;
+  o.frames = 12;
+  o.threads = 1;
+  const rgbl::RunResult serial = rgbl::Pipeline(o).run();
+  o.threads = 3;  // more threads than cores: the pool's helping waits under contention
+  const rgbl::RunResult pooled = rgbl::Pipeline(o).run();
+  REQUIRE(pooled.trajectory.poses.size() == serial.trajectory.poses.size());
+  for (std::size_t i = 0; i < serial.trajectory.poses.size(); ++i) {
+    CHECK(pooled.trajectory.poses[i].matrix() == serial.trajectory.poses[i].matrix());
+    CHECK(pooled.frames[i].result.state == serial.frames[i].result.state);
+  }
 }

@@ -43,8 +43,12 @@ struct PipelineOptions {
   std::filesystem::path settings;  // ORB-SLAM style settings YAML (RGB-L's LiDAR.* keys too); empty: defaults
   bool threaded = false;           // local mapping and loop closing in threads of their own
   bool loop_closing = true;        // false overrides the settings file
+  // Threads for a frame's own work: with 2 or more, the next frame is built (depth, extraction, the
+  // pyramid levels on every thread) while this one is tracked. 0 = the machine's hardware threads.
+  // The trajectory is the same for every count.
+  int threads = 0;
 
-  // Throws ConfigError naming the option (dataset, camera, step).
+  // Throws ConfigError naming the option (dataset, camera, step, threads).
   void validate() const;
 };
 
@@ -88,6 +92,7 @@ struct RunResult {
   int camera = 0;
   std::string depth;  // the depth source's registry name
   std::size_t first = 0, step = 1;
+  int threads = 1;  // frame threads (PipelineOptions::threads, resolved)
   bool threaded = false;
   bool loop_closing = false;
 
@@ -126,6 +131,10 @@ class Pipeline {
   // Throws rgbl::Error (ConfigError, ParseError). `registry` resolves options.depth; a settings file
   // replaces its lidar and rgbd entries with built-ins starting from the file's options.
   explicit Pipeline(const PipelineOptions& options, const DepthSourceRegistry& registry = builtin_depth_sources());
+  // A sequence opened by the caller (e.g. make_synthetic_sequence: the simulator, rendered as it is
+  // loaded); options.dataset and options.format are then the sequence's own.
+  Pipeline(std::unique_ptr<Sequence> sequence, const PipelineOptions& options,
+           const DepthSourceRegistry& registry = builtin_depth_sources());
 
   const PipelineOptions& options() const { return options_; }
   const Sequence& sequence() const { return *sequence_; }
@@ -145,6 +154,7 @@ class Pipeline {
 
   std::unique_ptr<DepthSource> make_depth_source() const;
   FeatureExtractor make_extractor() const;
+  int threads() const { return threads_; }  // options().threads resolved (0: the hardware threads)
   // The depth source's view of one loaded frame of the tracked camera (images shared, not copied).
   SensorFrame sensor_frame(const FrameInput& input) const;
 
@@ -174,6 +184,7 @@ class Pipeline {
   SystemOptions system_;
   OrbOptions orb_;
   std::size_t count_ = 0;
+  int threads_ = 1;
   std::vector<std::string> notes_;
 };
 

@@ -8,6 +8,7 @@
 #include "rgbl/loop/loop_closer.hpp"
 #include "rgbl/map/map.hpp"
 #include "rgbl/tracking/frame.hpp"
+#include "rgbl/tracking/frame_builder.hpp"
 #include "rgbl/tracking/options.hpp"
 #include "rgbl/tracking/tracker.hpp"
 
@@ -43,14 +44,17 @@ struct SystemOptions {
 };
 
 // Milliseconds spent per stage on one frame. mapping_ms is the inline local-mapping time (0 when
-// mapping runs in its own thread).
+// mapping runs in its own thread). With more than one thread, stages overlap (the depth source's
+// preparation beside extraction, the next frame's extraction beside this frame's tracking): each
+// stage's figure is its own duration, front_ms and total_ms what the frame cost the tracking thread.
 struct StageTiming {
   double depth_ms = 0.0;       // prepare + keypoint sampling
   double extraction_ms = 0.0;
   double tracking_ms = 0.0;
   double mapping_ms = 0.0;
   double loop_ms = 0.0;  // loop detection, verification and correction (keyframes only)
-  double total_ms = 0.0;
+  double front_ms = 0.0;  // wall, from the frame's turn to its pose (depth, extraction, tracking)
+  double total_ms = 0.0;  // wall, from the frame's turn to the next frame's
 };
 
 struct TrackResult {
@@ -65,6 +69,7 @@ struct TrackResult {
   bool step_rejected = false;  // a step beyond a vehicle's reach on weak evidence: weak, at the prediction
   int inliers = 0;           // local-map inliers (ok needs 30, 50 after a relocalisation)
   int keypoints = 0, keypoints_with_depth = 0;
+  std::size_t map_keyframes = 0, map_landmarks = 0;  // the map's size after this frame
   // A loop closed: inline, on this frame (a keyframe); threaded, by the loop thread since the last
   // frame (its frame_index says which keyframe closed it). The map was corrected.
   std::optional<LoopClosure> loop_closure;
@@ -89,6 +94,9 @@ class System {
   // Throws only what the depth source throws on unusable input (e.g. no right image for the stereo
   // source); a frame without depth (e.g. a dropped LiDAR scan) is tracked on the map alone.
   TrackResult track(const SensorFrame& frame);
+  // The same with the frame built beforehand (e.g. on another thread, by a FrameBuilder of its own):
+  // `sensor` is the frame it was built from, still needed for its scan (loop closing).
+  TrackResult track(const SensorFrame& sensor, PreparedFrame prepared);
 
   // Waits until threaded mapping and loop closing have processed every queued keyframe (no-op when
   // inline); the trajectory then includes every correction.
