@@ -2,11 +2,13 @@
 #include "rgbl/core/file.hpp"
 #include "rgbl/core/task_pool.hpp"
 #include "rgbl/pipeline/pipeline.hpp"
+#include "rgbl/sim/sim_sequence.hpp"
 #include "rgbl/sim/synthetic.hpp"
 #include "support/data.hpp"
 #include "support/temp_dir.hpp"
 
 #include <catch2/catch.hpp>
+#include <opencv2/core.hpp>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -192,6 +194,39 @@ TEST_CASE("frame threads: the same trajectory for 1, 2 and 3 threads (KITTI 04, 
   o.dataset = *seq;
   o.frames = 30;
   check_thread_counts_agree(o);
+}
+
+TEST_CASE("the simulator as an in-memory sequence: loaded frames equal the rendered ones, the pipeline tracks it") {
+  rgbl::SyntheticOptions sim;
+  sim.frames = 30;
+  sim.path.kind = rgbl::PathKind::curve;
+  sim.cameras = {true, false, false, false};
+  sim.render_depth = false;
+  const rgbl::SyntheticGenerator generator(sim);
+  auto sequence = rgbl::make_synthetic_sequence(sim);
+  REQUIRE(sequence->size() == 30);
+  CHECK(sequence->sensors().cameras[0]);
+  CHECK_FALSE(sequence->sensors().cameras[2]);
+  CHECK(sequence->sensors().lidar);
+  CHECK_FALSE(sequence->sensors().depth);
+  const rgbl::FrameInput frame = sequence->load(7);
+  CHECK(cv::norm(frame.images[0], generator.render_image(7, 0), cv::NORM_INF) == 0.0);
+  CHECK(frame.scan.size() == generator.render_scan(7).size());
+  CHECK(frame.timestamp == generator.timestamp(7));
+  REQUIRE(sequence->ground_truth().has_value());
+  CHECK(sequence->ground_truth()->poses[7].matrix() == generator.pose(7).matrix());
+  CHECK_THROWS_WITH(sequence->load(30), Contains("below 30"));
+
+  rgbl::PipelineOptions o;
+  o.frames = 20;
+  const rgbl::Pipeline pipeline(std::move(sequence), o);
+  const rgbl::RunResult run = pipeline.run();
+  CHECK(run.sequence_name == "synthetic");
+  CHECK(run.count(rgbl::TrackState::Ok) == 20);
+  REQUIRE(run.metrics.has_value());
+  CHECK(run.metrics->evaluation.ate.translation.rmse < 0.1);
+  CHECK(run.frames.back().result.map_keyframes == run.keyframes.size());
+  CHECK(run.frames.back().result.map_landmarks == run.landmarks.size());
 }
 
 TEST_CASE("a pipeline refuses bad options and data it cannot use before the first frame, naming them") {
