@@ -1,5 +1,6 @@
 // ORB extraction of 2000 features on a real KITTI frame: rgbl's extractor against cv::ORB.
 #include "bench_data.hpp"
+#include "rgbl/core/task_pool.hpp"
 #include "rgbl/features/matcher.hpp"
 #include "rgbl/features/orb.hpp"
 
@@ -37,6 +38,38 @@ void orb_opencv(benchmark::State& state) {
   state.counters["features"] = static_cast<double>(keypoints.size());
 }
 BENCHMARK(orb_opencv)->Name("orb/opencv")->Unit(benchmark::kMillisecond);
+
+// The same on two threads (wall time): rgbl's levels on a TaskPool of 2, OpenCV with 2 threads of its
+// own (it parallelises inside its filters).
+void orb_rgbl_threads(benchmark::State& state) {
+  const cv::Mat img = rgbl::bench::gray_image(0);
+  cv::setNumThreads(1);
+  rgbl::TaskPool pool(static_cast<int>(state.range(0)));
+  rgbl::OrbExtractor extractor;
+  std::vector<rgbl::Keypoint> keypoints;
+  std::vector<rgbl::Descriptor> descriptors;
+  for (auto _ : state) {
+    extractor.extract(img, keypoints, descriptors, &pool);
+    benchmark::DoNotOptimize(descriptors.data());
+  }
+  state.counters["features"] = static_cast<double>(keypoints.size());
+}
+BENCHMARK(orb_rgbl_threads)->Name("orb/rgbl/threads")->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void orb_opencv_threads(benchmark::State& state) {
+  const cv::Mat img = rgbl::bench::gray_image(0);
+  cv::setNumThreads(static_cast<int>(state.range(0)));
+  auto orb = cv::ORB::create(2000, 1.2F, 8);
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  for (auto _ : state) {
+    orb->detectAndCompute(img, cv::noArray(), keypoints, descriptors);
+    benchmark::DoNotOptimize(descriptors.data);
+  }
+  cv::setNumThreads(1);
+  state.counters["features"] = static_cast<double>(keypoints.size());
+}
+BENCHMARK(orb_opencv_threads)->Name("orb/opencv/threads")->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -13,7 +13,7 @@ void ReadAheadOptions::validate() const {
 
 ReadAhead::ReadAhead(const Sequence& sequence, const ReadAheadOptions& options)
     : sequence_(sequence), depth_(options.depth), first_(std::min(options.first, sequence.size())),
-      step_(options.step) {
+      step_(options.step), load_(options.load) {
   options.validate();
   const std::size_t available = (sequence.size() - first_ + step_ - 1) / step_;  // frames on the stride
   const std::size_t count = options.count == 0 ? available : std::min(options.count, available);
@@ -39,7 +39,7 @@ void ReadAhead::run() {
     }
     Slot slot;
     try {
-      slot.frame = sequence_.load(i);
+      slot.frame = sequence_.load(i, load_);
     } catch (...) {
       slot.error = std::current_exception();
     }

@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
+#include <deque>
 #include <cctype>
 #include <cmath>
 #include <mutex>
@@ -156,6 +156,12 @@ Pipeline::Pipeline(std::unique_ptr<Sequence> sequence, const PipelineOptions& op
   if (entry.needs.depth_image && !sensors.depth) {
     throw ConfigError("--depth", fmt::format("{} needs depth images: {} has none", depth_name_, where));
   }
+  // only what the tracked camera, the depth source and loop closing (the scan's place descriptor) read
+  load_.cameras = {};
+  load_.cameras[static_cast<std::size_t>(camera_)] = true;
+  load_.cameras[static_cast<std::size_t>(camera_ + 1)] = entry.needs.right_image;
+  load_.lidar = entry.needs.scan || system_.loop_closing.enabled;
+  load_.depth = entry.needs.depth_image;
   const std::size_t size = sequence_->size();
   if (options_.first >= size) {
     throw ConfigError("--first", fmt::format("a frame index below {} (the sequence's length)", size));
@@ -177,6 +183,7 @@ ReadAheadOptions Pipeline::read_ahead_options() const {
   read.first = options_.first;
   read.count = count_;
   read.step = options_.step;
+  read.load = load_;
   return read;
 }
 
@@ -233,37 +240,47 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
       add(std::move(record));
     }
   } else {
-    // Frame i + 1 is built (on the pool, its levels spread over every thread) while frame i is
-    // tracked here; two builders, as each depth source holds the frame it prepared. A build is a
-    // function of its frame alone, so the trajectory is the one of a single thread.
+    // The next `threads` frames are built on the pool (each one's levels spread over every thread)
+    // while frame i is tracked here, so a core is never idle while tracking runs. One builder per
+    // frame in flight, as each depth source holds the frame it prepared. A build is a function of
+    // its frame alone, so the trajectory is the one of a single thread.
     const auto pool = std::make_shared<TaskPool>(threads_);
-    std::array<FrameBuilder, 2> builders{
-        FrameBuilder(context_.calibration, system_.depth_noise, make_depth_source(), make_orb_extractor(orb_, pool), pool),
-        FrameBuilder(context_.calibration, system_.depth_noise, make_depth_source(), make_orb_extractor(orb_, pool), pool)};
+    const auto ahead_max = static_cast<std::size_t>(threads_);
+    std::vector<FrameBuilder> builders;
+    builders.reserve(ahead_max);
+    for (std::size_t b = 0; b < ahead_max; ++b) {
+      builders.emplace_back(context_.calibration, system_.depth_noise, make_depth_source(),
+                            make_orb_extractor(orb_, pool), pool);
+    }
     std::size_t started = 0;
-    const auto start = [&]() -> std::unique_ptr<InFlight> {
-      Stopwatch wait;
-      std::optional<FrameInput> input = frames.next();
-      if (!input) return nullptr;
-      auto f = std::make_unique<InFlight>();
-      f->io_wait_ms = wait.elapsed_ms();
-      f->input = std::move(*input);
-      f->sensor = sensor_frame(f->input);
-      FrameBuilder& builder = builders[started++ % 2];
-      f->build = pool->submit([&builder, f = f.get()] { f->prepared = builder.build(f->sensor); });
-      return f;
-    };
-    std::unique_ptr<InFlight> next = start();
-    while (next) {
-      if (stop.stop_requested()) {
-        stopped = records.size() < count_;
-        break;
+    bool loaded_all = false;
+    std::deque<std::unique_ptr<InFlight>> ahead;
+    const auto fill = [&] {  // frame k uses builder k % ahead_max: frame k - ahead_max's build is done
+      while (!loaded_all && ahead.size() < ahead_max) {
+        Stopwatch wait;
+        std::optional<FrameInput> input = frames.next();
+        if (!input) {
+          loaded_all = true;
+          break;
+        }
+        auto f = std::make_unique<InFlight>();
+        f->io_wait_ms = wait.elapsed_ms();
+        f->input = std::move(*input);
+        f->sensor = sensor_frame(f->input);
+        FrameBuilder& builder = builders[started++ % ahead_max];
+        f->build = pool->submit([&builder, f = f.get()] { f->prepared = builder.build(f->sensor); });
+        ahead.push_back(std::move(f));
       }
-      const std::unique_ptr<InFlight> current = std::move(next);
+    };
+    fill();
+    while (!ahead.empty()) {
+      if (stop.stop_requested()) break;
+      const std::unique_ptr<InFlight> current = std::move(ahead.front());
+      ahead.pop_front();
       Stopwatch wait;
-      current->build.wait();  // helps with its levels meanwhile; rethrows what loading or building threw
+      current->build.wait();  // helps with queued builds meanwhile; rethrows what building threw
       current->prepared.critical_ms = wait.elapsed_ms();
-      if (!stop.stop_requested()) next = start();  // overlaps the tracking below
+      if (!stop.stop_requested()) fill();  // the builds overlap the tracking below
       FrameRecord record;
       record.result = system->track(current->sensor, std::move(current->prepared));
       record.io_wait_ms = current->io_wait_ms;

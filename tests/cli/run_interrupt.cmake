@@ -1,10 +1,12 @@
 # Ctrl-C (SIGINT) during `rgbl run`: what was tracked is written, marked partial in summary.json, and
-# the exit status is 130. The signal is sent once the run reports progress (after >= 1 s of tracking).
+# the exit status is 130. The signal is sent once the run reports progress (after >= 1 s of tracking):
+# the dense stereo source (~60 ms a frame) keeps the run going for seconds, where the default tracks
+# the 51 frames in under one.
 include(${CMAKE_CURRENT_LIST_DIR}/data_dir.cmake)
 rgbl_find_data(kitti/odometry/sequences/04)
 file(REMOVE_RECURSE ${WORK_DIR})
 file(MAKE_DIRECTORY ${WORK_DIR})
-set(script "${RGBL} run ${data} --out ${WORK_DIR}/out > ${WORK_DIR}/log 2> ${WORK_DIR}/err & pid=$!
+set(script "${RGBL} run ${data} --depth stereo --out ${WORK_DIR}/out > ${WORK_DIR}/log 2> ${WORK_DIR}/err & pid=$!
 for i in $(seq 600); do grep -q '^frame ' ${WORK_DIR}/err && break; kill -0 $pid 2>/dev/null || break; sleep 0.1; done
 kill -INT $pid; wait $pid; echo $?")
 execute_process(COMMAND sh -c "${script}" OUTPUT_VARIABLE rc OUTPUT_STRIP_TRAILING_WHITESPACE)

@@ -34,7 +34,7 @@ struct KeypointDepth {
 };
 
 // What a source reads from each frame besides the tracked image: a pipeline checks the dataset has
-// it before the first frame.
+// it before the first frame, and loads no more than that (a scan also for loop closing).
 struct DepthSourceNeeds {
   bool scan = false;         // a LiDAR scan
   bool right_image = false;  // the rectified right image of the tracked camera's stereo pair

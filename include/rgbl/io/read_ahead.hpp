@@ -19,6 +19,7 @@ struct ReadAheadOptions {
   std::size_t first = 0;  // first frame index
   std::size_t count = 0;  // frames to deliver; 0 = up to the end of the sequence
   std::size_t step = 1;   // deliver every step-th frame (first, first + step, ...), >= 1
+  LoadOptions load{};     // what each frame loads (a KITTI frame's unused images are most of its load time)
 
   void validate() const;
 };
@@ -48,6 +49,7 @@ class ReadAhead {
   std::size_t first_;
   std::size_t step_;
   std::size_t end_;
+  LoadOptions load_;
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<Slot> queue_;

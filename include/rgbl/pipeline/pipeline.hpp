@@ -147,7 +147,8 @@ class Pipeline {
   const OrbOptions& orb_options() const { return orb_; }
   std::size_t frame_count() const { return count_; }   // frames run() tracks
   std::size_t frame_index(std::size_t i) const { return options_.first + i * options_.step; }
-  // The frames run() tracks, loaded ahead on a second thread.
+  // The frames run() tracks, loaded ahead on a second thread: only the images, scan and depth image
+  // that the tracked camera, the depth source and loop closing read.
   ReadAheadOptions read_ahead_options() const;
   // Decisions taken on the user's behalf (e.g. "LiDAR.Tr overrides the dataset's extrinsics"), to show once.
   const std::vector<std::string>& notes() const { return notes_; }
@@ -185,6 +186,7 @@ class Pipeline {
   OrbOptions orb_;
   std::size_t count_ = 0;
   int threads_ = 1;
+  LoadOptions load_;
   std::vector<std::string> notes_;
 };
 
