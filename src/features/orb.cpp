@@ -246,7 +246,13 @@ void OrbExtractor::detect_level(int level) {
 // every node holds one corner; when a full round would overshoot, split the most populated nodes
 // first. Each node then contributes its per_node strongest corners (ties: by position), and if that
 // is more than `target` the strongest of them are kept.
-void OrbExtractor::distribute(int target, std::vector<Candidate>& candidates, std::vector<Candidate>& selected) {
+void OrbExtractor::distribute(int target, Level& level) {
+  std::vector<Candidate>& candidates = level.candidates;
+  std::vector<Candidate>& selected = level.selected;
+  std::vector<Candidate>& bucketed = level.bucketed;
+  std::vector<Candidate>& leftover = level.leftover;
+  std::vector<Node>& nodes = level.nodes;
+  std::vector<Node>& next_nodes = level.next_nodes;
   selected.clear();
   if (candidates.empty() || target <= 0) return;
   const auto n = static_cast<int>(candidates.size());
@@ -272,27 +278,27 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& candidates, st
   // Start from roughly square root nodes side by side, as wide images would otherwise split badly.
   const int roots = std::max(1, static_cast<int>(std::lround((max_x - min_x) / (max_y - min_y))));
   const float root_w = (max_x - min_x) / static_cast<float>(roots);
-  nodes_.clear();
+  nodes.clear();
   {
     // Stable bucketing into the roots (candidates arrive in row-major order, which is kept).
     auto root_of = [&](const Candidate& c) {
       return std::min(roots - 1, static_cast<int>((c.x - min_x) / root_w));
     };
-    std::vector<int>& counts = root_counts_;
+    std::vector<int>& counts = level.root_counts;
     counts.assign(static_cast<std::size_t>(roots) + 1, 0);
     for (const auto& c : candidates) ++counts[static_cast<std::size_t>(root_of(c)) + 1];
     for (std::size_t r = 1; r < counts.size(); ++r) counts[r] += counts[r - 1];
-    bucketed_.resize(candidates.size());
+    bucketed.resize(candidates.size());
     std::vector<int> fill(counts.begin(), counts.end() - 1);
     for (const auto& c : candidates) {
-      bucketed_[static_cast<std::size_t>(fill[static_cast<std::size_t>(root_of(c))]++)] = c;
+      bucketed[static_cast<std::size_t>(fill[static_cast<std::size_t>(root_of(c))]++)] = c;
     }
-    candidates.swap(bucketed_);
+    candidates.swap(bucketed);
     for (int r = 0; r < roots; ++r) {
       const int begin = counts[static_cast<std::size_t>(r)], end = counts[static_cast<std::size_t>(r) + 1];
       if (end > begin) {
         const float bx0 = min_x + root_w * static_cast<float>(r);
-        nodes_.push_back({bx0, min_y, r == roots - 1 ? max_x : bx0 + root_w, max_y, begin, end});
+        nodes.push_back({bx0, min_y, r == roots - 1 ? max_x : bx0 + root_w, max_y, begin, end});
       }
     }
   }
@@ -316,68 +322,68 @@ void OrbExtractor::distribute(int target, std::vector<Candidate>& candidates, st
     }
   };
   for (;;) {
-    if (static_cast<int>(nodes_.size()) >= target_nodes) break;
-    const auto expandable = static_cast<int>(std::count_if(nodes_.begin(), nodes_.end(), splittable));
+    if (static_cast<int>(nodes.size()) >= target_nodes) break;
+    const auto expandable = static_cast<int>(std::count_if(nodes.begin(), nodes.end(), splittable));
     if (expandable == 0) break;
-    if (static_cast<int>(nodes_.size()) + 3 * expandable < target_nodes) {
-      next_nodes_.clear();
-      for (const Node& node : nodes_) {
+    if (static_cast<int>(nodes.size()) + 3 * expandable < target_nodes) {
+      next_nodes.clear();
+      for (const Node& node : nodes) {
         if (splittable(node)) {
-          split(node, next_nodes_);
+          split(node, next_nodes);
         } else {
-          next_nodes_.push_back(node);
+          next_nodes.push_back(node);
         }
       }
-      nodes_.swap(next_nodes_);
+      nodes.swap(next_nodes);
       continue;
     }
     // Last round: split the most populated nodes first, stopping as soon as the target is reached.
-    std::stable_sort(nodes_.begin(), nodes_.end(),
+    std::stable_sort(nodes.begin(), nodes.end(),
                      [](const Node& a, const Node& b) { return a.end - a.begin > b.end - b.begin; });
-    next_nodes_.clear();
+    next_nodes.clear();
     std::size_t i = 0;
-    for (; i < nodes_.size(); ++i) {
-      const std::size_t total = next_nodes_.size() + (nodes_.size() - i);
+    for (; i < nodes.size(); ++i) {
+      const std::size_t total = next_nodes.size() + (nodes.size() - i);
       if (static_cast<int>(total) >= target_nodes) break;
-      if (splittable(nodes_[i])) {
-        split(nodes_[i], next_nodes_);
+      if (splittable(nodes[i])) {
+        split(nodes[i], next_nodes);
       } else {
-        next_nodes_.push_back(nodes_[i]);
+        next_nodes.push_back(nodes[i]);
       }
     }
-    for (; i < nodes_.size(); ++i) next_nodes_.push_back(nodes_[i]);
-    nodes_.swap(next_nodes_);
+    for (; i < nodes.size(); ++i) next_nodes.push_back(nodes[i]);
+    nodes.swap(next_nodes);
   }
   const auto stronger = [](const Candidate& a, const Candidate& b) {
     if (a.response != b.response) return a.response > b.response;
     return a.y < b.y || (a.y == b.y && a.x < b.x);  // ties by position: independent of partition order
   };
-  selected.reserve(nodes_.size() * static_cast<std::size_t>(per_node));
-  for (const Node& node : nodes_) {
+  selected.reserve(nodes.size() * static_cast<std::size_t>(per_node));
+  for (const Node& node : nodes) {
     auto* first = candidates.data() + node.begin;
     auto* last = candidates.data() + node.end;
     const int keep = std::min(per_node, node.end - node.begin);
     std::partial_sort(first, first + keep, last, stronger);
     selected.insert(selected.end(), first, first + keep);
   }
-  leftover_.clear();
+  leftover.clear();
   if (static_cast<int>(selected.size()) > spread_target) {
     std::stable_sort(selected.begin(), selected.end(),
                      [](const Candidate& a, const Candidate& b) { return a.response > b.response; });
-    leftover_.assign(selected.begin() + spread_target, selected.end());
+    leftover.assign(selected.begin() + spread_target, selected.end());
     selected.resize(static_cast<std::size_t>(spread_target));
   }
   const int rest = target - static_cast<int>(selected.size());
   if (rest <= 0) return;
   // The rest from the corners the quadtree did not take: those the trimming above dropped and
   // everything behind each node's kept ones.
-  for (const Node& node : nodes_) {
+  for (const Node& node : nodes) {
     const int keep = std::min(per_node, node.end - node.begin);
-    leftover_.insert(leftover_.end(), candidates.begin() + node.begin + keep, candidates.begin() + node.end);
+    leftover.insert(leftover.end(), candidates.begin() + node.begin + keep, candidates.begin() + node.end);
   }
-  const auto take = std::min(static_cast<std::size_t>(rest), leftover_.size());
-  std::partial_sort(leftover_.begin(), leftover_.begin() + static_cast<std::ptrdiff_t>(take), leftover_.end(), stronger);
-  selected.insert(selected.end(), leftover_.begin(), leftover_.begin() + static_cast<std::ptrdiff_t>(take));
+  const auto take = std::min(static_cast<std::size_t>(rest), leftover.size());
+  std::partial_sort(leftover.begin(), leftover.begin() + static_cast<std::ptrdiff_t>(take), leftover.end(), stronger);
+  selected.insert(selected.end(), leftover.begin(), leftover.begin() + static_cast<std::ptrdiff_t>(take));
 }
 
 void OrbExtractor::describe_level(int level) {
@@ -479,13 +485,26 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<Keypoint>& keypoints
     }
   };
   each_level([this](int l) { detect_level(l); });
-  int carry = 0;  // a level's unused budget goes to the next one
+  // A level keeps exactly its budget when it has at least that many candidates; only a level that
+  // falls short passes budget on. When none does, the levels are independent (the usual case).
+  bool independent = true;
   for (std::size_t l = 0; l < levels; ++l) {
-    const int target = budgets_[l] + carry;
-    distribute(target, levels_[l].candidates, levels_[l].selected);
-    carry = target - static_cast<int>(levels_[l].selected.size());
+    independent = independent && static_cast<int>(levels_[l].candidates.size()) >= budgets_[l];
   }
-  each_level([this](int l) { describe_level(l); });
+  if (independent) {
+    each_level([this](int l) {
+      distribute(budgets_[static_cast<std::size_t>(l)], levels_[static_cast<std::size_t>(l)]);
+      describe_level(l);
+    });
+  } else {
+    int carry = 0;  // a level's unused budget goes to the next one
+    for (std::size_t l = 0; l < levels; ++l) {
+      const int target = budgets_[l] + carry;
+      distribute(target, levels_[l]);
+      carry = target - static_cast<int>(levels_[l].selected.size());
+    }
+    each_level([this](int l) { describe_level(l); });
+  }
   for (const Level& lv : levels_) {
     keypoints.insert(keypoints.end(), lv.keypoints.begin(), lv.keypoints.end());
     descriptors.insert(descriptors.end(), lv.descriptors.begin(), lv.descriptors.end());

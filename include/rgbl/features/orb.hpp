@@ -108,6 +108,11 @@ class OrbExtractor {
     std::vector<unsigned char> cell_strong;
     std::vector<Candidate> candidates;
     std::vector<Candidate> selected;
+    // the quadtree's scratch
+    std::vector<int> root_counts;
+    std::vector<Candidate> bucketed;
+    std::vector<Candidate> leftover;  // corners the quadtree did not take
+    std::vector<Node> nodes, next_nodes;
     cv::Mat blurred;
     std::vector<int> pattern_offsets;
     std::vector<Keypoint> keypoints;
@@ -115,8 +120,9 @@ class OrbExtractor {
   };
   void build_pyramid(const cv::Mat& gray);
   void detect_level(int level);
-  // Sequential over levels: a level's unused budget moves to the next.
-  void distribute(int target, std::vector<Candidate>& candidates, std::vector<Candidate>& selected);
+  // Keeps `target` of the level's candidates (all of them when fewer: the rest of the budget then
+  // moves to the next level, which is why levels are distributed in order unless none falls short).
+  void distribute(int target, Level& level);
   void describe_level(int level);
 
   OrbOptions options_;
@@ -128,10 +134,6 @@ class OrbExtractor {
   // Scratch reused across calls.
   std::vector<cv::Mat> pyramid_;
   std::vector<Level> levels_;
-  std::vector<int> root_counts_;
-  std::vector<Candidate> bucketed_;
-  std::vector<Candidate> leftover_;  // corners the quadtree did not take
-  std::vector<Node> nodes_, next_nodes_;
 };
 
 }  // namespace rgbl
