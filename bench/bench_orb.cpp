@@ -9,56 +9,27 @@
 
 namespace {
 
-// Both run on one core: OpenCV's own threading (used inside cv::resize and cv::GaussianBlur too)
-// is switched off, so wall and CPU time measure the same single thread.
-void orb_rgbl(benchmark::State& state) {
+// rgbl's extractor (defaults: 2000 features, 8 levels, 1.2) and cv::ORB with the same settings. With
+// `threads` 1 both run on one core: OpenCV's own threading (used inside cv::resize and
+// cv::GaussianBlur too) is switched off, so wall and CPU time measure the same single thread. With 2,
+// rgbl's levels run on a TaskPool of 2 and OpenCV gets 2 threads of its own (timed as wall time).
+void extract_rgbl(benchmark::State& state, int threads) {
   const cv::Mat img = rgbl::bench::gray_image(0);
   cv::setNumThreads(1);
-  rgbl::OrbExtractor extractor;  // defaults: 2000 features, 8 levels, 1.2
-  std::vector<rgbl::Keypoint> keypoints;
-  std::vector<rgbl::Descriptor> descriptors;
-  for (auto _ : state) {
-    extractor.extract(img, keypoints, descriptors);
-    benchmark::DoNotOptimize(descriptors.data());
-  }
-  state.counters["features"] = static_cast<double>(keypoints.size());
-}
-BENCHMARK(orb_rgbl)->Name("orb/rgbl")->Unit(benchmark::kMillisecond);
-
-void orb_opencv(benchmark::State& state) {
-  const cv::Mat img = rgbl::bench::gray_image(0);
-  cv::setNumThreads(1);
-  auto orb = cv::ORB::create(2000, 1.2F, 8);
-  std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;
-  for (auto _ : state) {
-    orb->detectAndCompute(img, cv::noArray(), keypoints, descriptors);
-    benchmark::DoNotOptimize(descriptors.data);
-  }
-  state.counters["features"] = static_cast<double>(keypoints.size());
-}
-BENCHMARK(orb_opencv)->Name("orb/opencv")->Unit(benchmark::kMillisecond);
-
-// The same on two threads (wall time): rgbl's levels on a TaskPool of 2, OpenCV with 2 threads of its
-// own (it parallelises inside its filters).
-void orb_rgbl_threads(benchmark::State& state) {
-  const cv::Mat img = rgbl::bench::gray_image(0);
-  cv::setNumThreads(1);
-  rgbl::TaskPool pool(static_cast<int>(state.range(0)));
+  rgbl::TaskPool pool(threads);
   rgbl::OrbExtractor extractor;
   std::vector<rgbl::Keypoint> keypoints;
   std::vector<rgbl::Descriptor> descriptors;
   for (auto _ : state) {
-    extractor.extract(img, keypoints, descriptors, &pool);
+    extractor.extract(img, keypoints, descriptors, threads > 1 ? &pool : nullptr);
     benchmark::DoNotOptimize(descriptors.data());
   }
   state.counters["features"] = static_cast<double>(keypoints.size());
 }
-BENCHMARK(orb_rgbl_threads)->Name("orb/rgbl/threads")->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
-void orb_opencv_threads(benchmark::State& state) {
+void extract_opencv(benchmark::State& state, int threads) {
   const cv::Mat img = rgbl::bench::gray_image(0);
-  cv::setNumThreads(static_cast<int>(state.range(0)));
+  cv::setNumThreads(threads);
   auto orb = cv::ORB::create(2000, 1.2F, 8);
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
@@ -69,6 +40,14 @@ void orb_opencv_threads(benchmark::State& state) {
   cv::setNumThreads(1);
   state.counters["features"] = static_cast<double>(keypoints.size());
 }
+
+void orb_rgbl(benchmark::State& state) { extract_rgbl(state, 1); }
+BENCHMARK(orb_rgbl)->Name("orb/rgbl")->Unit(benchmark::kMillisecond);
+void orb_opencv(benchmark::State& state) { extract_opencv(state, 1); }
+BENCHMARK(orb_opencv)->Name("orb/opencv")->Unit(benchmark::kMillisecond);
+void orb_rgbl_threads(benchmark::State& state) { extract_rgbl(state, static_cast<int>(state.range(0))); }
+BENCHMARK(orb_rgbl_threads)->Name("orb/rgbl/threads")->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+void orb_opencv_threads(benchmark::State& state) { extract_opencv(state, static_cast<int>(state.range(0))); }
 BENCHMARK(orb_opencv_threads)->Name("orb/opencv/threads")->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
