@@ -233,10 +233,17 @@ void require_image_file(const std::filesystem::path& file, std::string_view what
   std::array<unsigned char, 24> header{};
   in.read(reinterpret_cast<char*>(header.data()), header.size());  // NOLINT
   static constexpr std::array<unsigned char, 8> kSignature{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (in.gcount() != static_cast<std::streamsize>(header.size()) ||
-      !std::equal(kSignature.begin(), kSignature.end(), header.begin()) ||
+  const auto read = static_cast<std::size_t>(in.gcount());
+  const bool png = read >= kSignature.size() && std::equal(kSignature.begin(), kSignature.end(), header.begin());
+  const bool jpeg = read >= 3 && header[0] == 0xFF && header[1] == 0xD8 && header[2] == 0xFF;
+  // Only PNG and JPEG reach the decoder: cv::imread picks a decoder by the content, and some of
+  // OpenCV's (GDCM for DICOM) abort the process on malformed input instead of failing.
+  if (!png && !jpeg) {
+    throw ParseError(file, 0, fmt::format("not a PNG or JPEG file (by its first bytes; expected {})", what));
+  }
+  if (!png || read != header.size() ||
       std::string_view(reinterpret_cast<const char*>(header.data()) + 12, 4) != "IHDR") {  // NOLINT
-    return;  // not a PNG (or a broken one): the decoder says what is wrong
+    return;  // a JPEG, or a broken PNG: the decoder says what is wrong
   }
   const auto be32 = [&](std::size_t at) {
     return (std::uint64_t{header[at]} << 24) | (std::uint64_t{header[at + 1]} << 16) |

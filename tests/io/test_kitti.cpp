@@ -180,7 +180,15 @@ TEST_CASE("KITTI loader: bad input names the file", "[io][kitti][bad-input]") {
     rgbl::test::SyntheticKitti kitti;
     kitti.root.write("sequences/07/image_0/000001.png", "this is not a PNG at all");
     const auto seq = rgbl::open_kitti_odometry(kitti.dir);
-    CHECK_THAT(parse_error_message([&] { seq->load(1); }, kitti.image0(1)), Contains("cannot read or decode"));
+    CHECK_THAT(parse_error_message([&] { seq->load(1); }, kitti.image0(1)), Contains("not a PNG or JPEG file"));
+  }
+  SECTION("a DICOM file named .png is refused before any decoder sees it") {
+    // cv::imread chooses the decoder by content; GDCM's aborted the process on this one (found by
+    // fuzz_image): 128 bytes of preamble, "DICM", then nothing it can read
+    rgbl::test::SyntheticKitti kitti;
+    kitti.root.write("sequences/07/image_0/000001.png", std::string(128, '\0') + "DICM\x02\x00\x01");
+    const auto seq = rgbl::open_kitti_odometry(kitti.dir);
+    CHECK_THAT(parse_error_message([&] { seq->load(1); }, kitti.image0(1)), Contains("not a PNG or JPEG file"));
   }
   SECTION("truncated PNG") {
     rgbl::test::SyntheticKitti kitti;
