@@ -36,12 +36,6 @@ Memory memory() {
   return m;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 struct Row {
   std::size_t frame;
   rgbl::TrackState state;
@@ -111,7 +105,7 @@ int main(int argc, char** argv) {
     const auto window = [&](std::size_t from, std::size_t to, auto field) {
       std::vector<double> v;
       for (std::size_t i = from; i < std::min(to, rows.size()); ++i) v.push_back(field(rows[i]));
-      return median(std::move(v));
+      return rgbl::stage_stats(std::move(v)).median;
     };
     const auto front = [](const Row& r) { return r.front_ms; };
     const auto total = [](const Row& r) { return r.total_ms; };

@@ -478,7 +478,7 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<Keypoint>& keypoints
   build_pyramid(gray);
   const auto levels = static_cast<std::size_t>(options_.num_levels);
   const auto each_level = [&](auto&& fn) {
-    if (pool != nullptr && pool->threads() > 1) {
+    if (pool != nullptr) {  // runs them in order itself when the pool has one thread
       pool->parallel_for(levels, [&](std::size_t l) { fn(static_cast<int>(l)); });
     } else {
       for (std::size_t l = 0; l < levels; ++l) fn(static_cast<int>(l));

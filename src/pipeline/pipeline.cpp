@@ -9,9 +9,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <deque>
 #include <cctype>
 #include <cmath>
+#include <deque>
 #include <mutex>
 #include <shared_mutex>
 
@@ -219,17 +219,13 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
   std::vector<FrameRecord> records;
   records.reserve(count_);
   Stopwatch wall;
-  bool stopped = false;
   const auto add = [&](FrameRecord record) {
     records.push_back(std::move(record));
     if (progress) progress(records.back(), records.size(), count_);
   };
   if (threads_ <= 1) {
     for (;;) {
-      if (stop.stop_requested()) {
-        stopped = records.size() < count_;
-        break;
-      }
+      if (stop.stop_requested()) break;
       Stopwatch wait;
       std::optional<FrameInput> input = frames.next();
       const double wait_ms = wait.elapsed_ms();
@@ -286,8 +282,8 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
       record.io_wait_ms = current->io_wait_ms;
       add(std::move(record));
     }
-    stopped = stop.stop_requested() && records.size() < count_;
   }
+  const bool stopped = stop.stop_requested() && records.size() < count_;
   system->finish();
   RunResult out = collect(*system, std::move(records), wall.elapsed_ms() / 1000.0);
   out.stopped = stopped;

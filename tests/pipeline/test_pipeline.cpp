@@ -6,6 +6,7 @@
 #include "rgbl/sim/synthetic.hpp"
 #include "support/data.hpp"
 #include "support/temp_dir.hpp"
+#include "support/thread_counts.hpp"
 
 #include <catch2/catch.hpp>
 #include <opencv2/core.hpp>
@@ -146,40 +147,10 @@ TEST_CASE("KITTI 04 at 2.5 Hz: the second frame is placed from both starts and r
   CHECK(step == Approx(true_step).margin(0.2));
 }
 
-namespace {
-// The same run with 1, 2 and 3 frame threads: every pose, state and inlier count equal to the bit.
-void check_thread_counts_agree(rgbl::PipelineOptions o) {
-  o.threads = 1;
-  const rgbl::RunResult serial = rgbl::Pipeline(o).run();
-  CHECK(serial.threads == 1);
-  REQUIRE(serial.frames.size() >= 10);
-  for (const int threads : {2, 3}) {
-    o.threads = threads;
-    const rgbl::RunResult run = rgbl::Pipeline(o).run();
-    CHECK(run.threads == threads);
-    REQUIRE(run.frames.size() == serial.frames.size());
-    for (std::size_t i = 0; i < serial.frames.size(); ++i) {
-      const auto& a = serial.frames[i].result;
-      const auto& b = run.frames[i].result;
-      INFO("frame " << a.frame_index << ", " << threads << " threads");
-      CHECK(b.state == a.state);
-      CHECK(b.inliers == a.inliers);
-      CHECK(b.keypoints_with_depth == a.keypoints_with_depth);
-      CHECK(b.keyframe == a.keyframe);
-      CHECK(run.trajectory.poses[i].matrix() == serial.trajectory.poses[i].matrix());
-    }
-    CHECK(run.landmarks.size() == serial.landmarks.size());
-    // the frame's critical path shrinks, its stages do not vanish
-    CHECK(run.timings().front.median > 0.0);
-    CHECK(run.timings().extraction.median > 0.0);
-  }
-}
-}  // namespace
-
 TEST_CASE("frame threads: the same trajectory for 1, 2 and 3 threads (synthetic curve)") {
   auto o = options();
   o.frames = 24;
-  check_thread_counts_agree(o);
+  rgbl::test::check_thread_counts_agree(o, {2, 3});
   // 0 means the machine's threads; out-of-range counts are refused naming the option
   o.threads = 0;
   CHECK(rgbl::Pipeline(o).threads() == rgbl::TaskPool::hardware_threads());
@@ -193,7 +164,7 @@ TEST_CASE("frame threads: the same trajectory for 1, 2 and 3 threads (KITTI 04, 
   rgbl::PipelineOptions o;
   o.dataset = *seq;
   o.frames = 30;
-  check_thread_counts_agree(o);
+  rgbl::test::check_thread_counts_agree(o, {2, 3});
 }
 
 TEST_CASE("the simulator as an in-memory sequence: loaded frames equal the rendered ones, the pipeline tracks it") {
