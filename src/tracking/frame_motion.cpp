@@ -12,6 +12,7 @@
 #include <numbers>
 #include <random>
 #include <span>
+#include <iterator>
 #include <tuple>
 #include <vector>
 
@@ -73,6 +74,21 @@ std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const T
 
 }  // namespace
 
+std::vector<bool> ground_keypoints(const PinholeCamera& camera, const Frame& frame, const TrackerOptions& options) {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<std::size_t> keypoint;
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.depth_sigma[i] <= 0.0F) continue;
+    points.push_back(camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y), frame.depth[i]));
+    keypoint.push_back(i);
+  }
+  const std::vector<bool> on_plane = ground_points(points, options);
+  if (on_plane.empty()) return {};
+  std::vector<bool> ground(frame.size(), false);
+  for (std::size_t k = 0; k < keypoint.size(); ++k) ground[keypoint[k]] = on_plane[k];
+  return ground;
+}
+
 // Why: breaks the feedback of the constant-velocity prediction on periodic or weak texture (fences,
 // grass), where guided matching around a slightly wrong prediction finds matches that confirm it; the
 // prior keeps a rigid object that moves with the camera (a van ahead at the same speed) from taking
@@ -80,7 +96,9 @@ std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const T
 std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& camera, const Frame& last, const Frame& frame,
                                                        const TrackerOptions& options,
                                                        const std::optional<Eigen::Isometry3d>& prior,
-                                                       std::vector<bool>* moving) {
+                                                       std::vector<bool>* moving,
+                                                       std::optional<RivalMotion>* rival) {
+  if (rival != nullptr) rival->reset();
   std::vector<Descriptor> last_desc, cur_desc;
   std::vector<Eigen::Vector3d> last_pts, cur_pts;
   std::vector<int> cur_cell;  // coverage cell of each current point
@@ -133,9 +151,12 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     T.matrix() = Eigen::umeyama(a, b, false);
     return T;
   };
+  std::vector<int> all(static_cast<std::size_t>(n));
+  for (int m = 0; m < n; ++m) all[static_cast<std::size_t>(m)] = m;
+  std::span<const int> pool = all;  // the matches a consensus may take
   auto inliers_of = [&](const Eigen::Isometry3d& T, std::vector<int>& out) {
     out.clear();
-    for (int m = 0; m < n; ++m) {
+    for (const int m : pool) {
       const auto& [q, t] = matches[static_cast<std::size_t>(m)];
       const Eigen::Vector3d& pc = cur_pts[static_cast<std::size_t>(q)];
       if ((T * last_pts[static_cast<std::size_t>(t)] - pc).norm() < depth_tolerance(pc.z(), options)) out.push_back(m);
@@ -168,8 +189,8 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
   // Seeds: matched points that agree with T (static) or lie beyond motion_gate_factor tolerances
   // (moving); other keypoints with depth take the label of the nearest seed within
   // moving_label_radius px at a continuous depth (one rigid surface).
-  auto label_moving = [&](const Eigen::Isometry3d& T) {
-    moving->assign(frame.size(), false);
+  auto label_moving = [&](const Eigen::Isometry3d& T, std::vector<bool>* labels) {
+    labels->assign(frame.size(), false);
     if (options.motion_gate_factor <= 0.0 || options.moving_label_radius <= 0.0) return;
     std::vector<signed char> seed(frame.size(), -1);  // -1 none, 0 static, 1 moving
     for (int m = 0; m < n; ++m) {
@@ -188,7 +209,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     };
     for (std::size_t i = 0; i < frame.size(); ++i) {
       if (seed[i] == 1) {
-        (*moving)[i] = true;
+        (*labels)[i] = true;
         continue;
       }
       if (seed[i] == 0 || frame.depth_sigma[i] <= 0.0F) continue;
@@ -206,7 +227,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
           label = seed[sj];
         }
       }
-      (*moving)[i] = label == 1;
+      (*labels)[i] = label == 1;
     }
   };
   const bool use_prior = prior.has_value();
@@ -254,7 +275,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     if (best_near.empty()) return std::nullopt;
     refine(T_near, best_near);
     if (!near_prior(T_near) || static_cast<int>(best_near.size()) < options.ransac_min_inliers) return std::nullopt;
-    if (moving != nullptr) label_moving(T_near);
+    if (moving != nullptr) label_moving(T_near, moving);
     if (!best.empty() && best.size() > best_near.size() && !near_prior(T_best)) {
       logger()->debug("frame {}: depth RANSAC keeps the motion near constant velocity ({} inliers) over another "
                       "({} inliers, {:.2f} m from it)", frame.index, best_near.size(), best.size(),
@@ -264,7 +285,40 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
   }
   refine(T_best, best);
   if (static_cast<int>(best.size()) < options.ransac_min_inliers) return std::nullopt;
-  if (moving != nullptr) label_moving(T_best);
+  if (moving != nullptr) label_moving(T_best, moving);
+  if (rival != nullptr) {
+    // The same RANSAC on the matches the winner leaves out (its own seed, so the winner is unchanged).
+    std::vector<int> rest;
+    std::set_difference(all.begin(), all.end(), best.begin(), best.end(), std::back_inserter(rest));
+    if (static_cast<int>(rest.size()) >= 3) {
+      pool = rest;
+      std::uniform_int_distribution<std::size_t> pick_rest(0, rest.size() - 1);
+      std::mt19937 rng_rest(13);
+      std::vector<int> second;
+      Score second_score{-1, -1, 0};
+      Eigen::Isometry3d T_second = Eigen::Isometry3d::Identity();
+      for (int it = 0; it < options.ransac_iterations; ++it) {
+        const std::array<int, 3> sample = {rest[pick_rest(rng_rest)], rest[pick_rest(rng_rest)], rest[pick_rest(rng_rest)]};
+        if (sample[0] == sample[1] || sample[1] == sample[2] || sample[0] == sample[2]) continue;
+        const Eigen::Isometry3d T = fit(sample);
+        inliers_of(T, current);
+        const auto score = score_of(current);
+        if (score > second_score) {
+          second.swap(current);
+          second_score = score;
+          T_second = T;
+        }
+      }
+      refine(T_second, second);
+      if (static_cast<int>(second.size()) >= 3) {
+        RivalMotion r;
+        r.T_cur_last = T_second;
+        r.inliers = second.size();
+        if (moving != nullptr) label_moving(T_second, &r.moving);
+        *rival = std::move(r);
+      }
+    }
+  }
   return T_best;
 }
 

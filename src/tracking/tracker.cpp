@@ -130,7 +130,7 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
   h.reference = reference_;
   h.relocalisation_frame = last_relocalisation_frame_;
   bool ok = false;
-  std::optional<Frame> weak_start;  // a second start against the reference keyframe (see there)
+  std::vector<OtherStart> others;  // more starts against the reference keyframe (see there)
   if (has_pose(state_)) {
     if (velocity_ && last_frame_) {
       first.motion_inliers =
@@ -139,10 +139,10 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
     }
     if (!ok) {
       clear_matches(frame);
-      ok = track_reference_keyframe(frame, weak_start);
-      if (!ok && weak_start) {
-        frame = std::move(*weak_start);  // the only start that converged
-        weak_start.reset();
+      ok = track_reference_keyframe(frame, others);
+      if (!ok && !others.empty()) {
+        frame = std::move(others.front().frame);  // the first other start that converged
+        others.erase(others.begin());
         ok = true;
       }
     }
@@ -170,21 +170,42 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
     const KeyframeId reference = h.reference;
     first.local = track_local_map(frame, reference, h.relocalisation_frame, views);
     h.reference = first.local.reference;
-    if (weak_start) {
-      // two starts converged to different poses: the local map decides
-      const LocalMapResult other = track_local_map(*weak_start, reference, h.relocalisation_frame, views);
-      logger()->debug("frame {}: against the reference keyframe, the local map finds {} of {} points from the last "
-                      "pose, {} of {} from the weak depth consensus ({:.2f} m apart)", frame.index,
-                      first.local.inliers, first.local.visible, other.inliers, other.visible,
-                      (frame.T_cam_world.inverse().translation() - weak_start->T_cam_world.inverse().translation()).norm());
-      const double dt = last_frame_ ? frame.timestamp - last_frame_->timestamp : 0.0;
+    const double dt = last_frame_ ? frame.timestamp - last_frame_->timestamp : 0.0;
+    // A rival motion is judged as the depth consensus ranks motions: the road does not move, so the
+    // start whose local map re-finds more points on the road wins, then the one that re-finds more.
+    std::vector<bool> ground;
+    if (!others.empty()) ground = ground_keypoints(camera_, frame, options_);
+    auto on_road = [&](const Frame& f) {
+      int count = 0;
+      for (std::size_t i = 0; i < ground.size(); ++i) count += ground[i] && f.landmarks[i].valid() ? 1 : 0;
+      return count;
+    };
+    for (OtherStart& other_start : others) {
+      // starts converged to different poses: the local map decides. A rival motion's views count
+      // only if it wins, so that a start that loses leaves the map's statistics as they were.
+      ViewLog rival_views;
+      ViewLog& other_views = other_start.rival ? rival_views : views;
+      const LocalMapResult other = track_local_map(other_start.frame, reference, h.relocalisation_frame, other_views);
+      logger()->debug("frame {}: against the reference keyframe, the local map finds {} of {} points ({} on the road) "
+                      "from the first start, {} of {} ({} on the road) from the {} ({:.2f} m apart)", frame.index,
+                      first.local.inliers, first.local.visible, on_road(frame), other.inliers, other.visible,
+                      on_road(other_start.frame),
+                      other_start.rival ? "second rigid motion in view" : "weak depth consensus",
+                      (frame.T_cam_world.inverse().translation() - other_start.frame.T_cam_world.inverse().translation()).norm());
       // Poses further apart than a vehicle's step tolerance are evidence that contradicts itself,
-      // whichever wins: the frame is weak (and makes a keyframe), never silently ok.
-      h.weak = !check_step(frame.T_cam_world, weak_start->T_cam_world, 0.0, dt, options_).plausible;
-      if (other.inliers > first.local.inliers) {
-        frame = std::move(*weak_start);
+      // whichever wins: the frame is weak (and makes a keyframe), never silently ok. Two rigid
+      // motions in view (the scene and a car) are not: each is a consensus of its own.
+      const bool apart = !check_step(frame.T_cam_world, other_start.frame.T_cam_world, 0.0, dt, options_).plausible;
+      if (apart && !other_start.rival) h.weak = true;
+      // A rival within a step's tolerance of the first start is the same motion found twice.
+      const bool better = (apart || !other_start.rival) &&
+                          std::pair(on_road(other_start.frame), other.inliers) > std::pair(on_road(frame), first.local.inliers);
+      if (better) {
+        frame = std::move(other_start.frame);
         first.local = other;
         h.reference = other.reference;
+        views.visible.insert(views.visible.end(), rival_views.visible.begin(), rival_views.visible.end());
+        views.found.insert(views.found.end(), rival_views.found.begin(), rival_views.found.end());
       }
     }
     ok = first.local.ok;
@@ -497,7 +518,8 @@ int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const
   return inliers;
 }
 
-bool Tracker::track_reference_keyframe(Frame& frame, std::optional<Frame>& weak_start) const {
+bool Tracker::track_reference_keyframe(Frame& frame, std::vector<OtherStart>& others) const {
+  others.clear();
   std::vector<Descriptor> train;
   std::vector<LandmarkId> train_landmarks;
   {
@@ -519,6 +541,10 @@ bool Tracker::track_reference_keyframe(Frame& frame, std::optional<Frame>& weak_
   // after initialisation has no velocity yet, and the last pose is then a poor guess at speed), else
   // from the last pose, and then also from the weak consensus: far off at speed, the last pose can
   // converge on distant points to a wrong pose that many matches fit (KITTI 04 at 2.5 Hz: 5 m short).
+  // Without a velocity the largest rigid consensus may also be a car moving with the camera, or
+  // aliasing, while the scene's matches fade with the distance travelled (KITTI 04 at 1.7 Hz: 20
+  // points on a 2 m sideways motion, 7 on the true 7.9 m one): the second rigid motion among the
+  // matches is another start. The local map decides between the starts.
   frame.T_cam_world = last_frame_ ? last_frame_->T_cam_world : Eigen::Isometry3d::Identity();
   auto start_from = [&](Frame& f, const Eigen::Isometry3d& T_cur_last) {
     f.T_cam_world = T_cur_last * last_frame_->T_cam_world;
@@ -526,20 +552,28 @@ bool Tracker::track_reference_keyframe(Frame& frame, std::optional<Frame>& weak_
     // consensus are objects moving against the scene (or aliasing), not evidence for the pose.
     drop_moving_matches(f);
   };
+  auto add_rival = [&](const Frame& matched, std::optional<RivalMotion>& rival) {
+    if (!rival) return;
+    OtherStart& other = others.emplace_back(OtherStart{matched, true});
+    other.frame.moving = std::move(rival->moving);
+    start_from(other.frame, rival->T_cur_last);
+  };
   if (last_frame_ && options_.ransac_prediction) {
     TrackerOptions guess_options = options_;  // a guess only: the optimisation below decides
     guess_options.ransac_min_inliers = options_.ransac_guess_min_inliers;
-    if (const auto T_cur_last =
-            estimate_frame_motion(camera_, *last_frame_, frame, guess_options, trusted_velocity(), &frame.moving)) {
+    std::optional<RivalMotion> rival;
+    if (const auto T_cur_last = estimate_frame_motion(camera_, *last_frame_, frame, guess_options, trusted_velocity(),
+                                                      &frame.moving, &rival)) {
+      add_rival(frame, rival);
       start_from(frame, *T_cur_last);
     } else {
-      weak_start = frame;
+      Frame weak = frame;
       guess_options.ransac_min_inliers = 3;  // any consensus; the same sampling finds the same motion
-      if (const auto T_weak = estimate_frame_motion(camera_, *last_frame_, *weak_start, guess_options,
-                                                    trusted_velocity(), &weak_start->moving)) {
-        start_from(*weak_start, *T_weak);
-      } else {
-        weak_start.reset();
+      if (const auto T_weak = estimate_frame_motion(camera_, *last_frame_, weak, guess_options, trusted_velocity(),
+                                                    &weak.moving, &rival)) {
+        add_rival(frame, rival);
+        start_from(weak, *T_weak);
+        others.insert(others.begin(), OtherStart{std::move(weak), false});
       }
     }
   }
@@ -548,7 +582,7 @@ bool Tracker::track_reference_keyframe(Frame& frame, std::optional<Frame>& weak_
     discard_outliers(f);
     return inliers >= options_.min_pose_inliers;
   };
-  if (weak_start && !optimise(*weak_start)) weak_start.reset();
+  std::erase_if(others, [&](OtherStart& other) { return !optimise(other.frame); });
   return optimise(frame);
 }
 

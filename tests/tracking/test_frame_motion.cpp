@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -169,6 +170,46 @@ TEST_CASE("frame motion: a truck alongside at the camera's speed covers more of 
     CHECK(truck == 160);
     CHECK(truck_moving == truck);
     CHECK(scene_moving == 0);
+  }
+  SECTION("coverage alone picks the truck; the rival is the scene's motion, exactly, with its own labels") {
+    std::vector<bool> moving;
+    std::optional<rgbl::RivalMotion> rival;
+    const auto T = rgbl::estimate_frame_motion(cam, last, cur, coverage_only, std::nullopt, &moving, &rival);
+    REQUIRE(T);
+    CHECK(translation_error(*T, T_true) > 0.8);
+    REQUIRE(rival);
+    CHECK(translation_error(rival->T_cur_last, T_true) < 1e-3);
+    CHECK(rotation_error_deg(rival->T_cur_last, T_true) < 1e-3);
+    // the road points and the facades the winner did not take (some facades agree with both)
+    CHECK(rival->inliers >= 40);
+    CHECK(rival->inliers <= 52);
+    REQUIRE(rival->moving.size() == cur.size());
+    int truck_moving = 0;
+    for (std::size_t i = 0; i < cur.size(); ++i) {
+      const bool on_truck = std::abs(cam.unproject({cur.keypoints[i].x, cur.keypoints[i].y}, cur.depth[i]).x() - 2.5) < 1e-3;
+      truck_moving += on_truck && rival->moving[i] ? 1 : 0;
+    }
+    CHECK(truck_moving == 160);
+  }
+  SECTION("with a prior there is no rival: the prior already chose") {
+    std::optional<rgbl::RivalMotion> rival;
+    REQUIRE(rgbl::estimate_frame_motion(cam, last, cur, options, T_true, nullptr, &rival));
+    CHECK_FALSE(rival);
+  }
+  SECTION("the road's keypoints: all 40 and nothing else") {
+    const std::vector<bool> ground = rgbl::ground_keypoints(cam, cur, options);
+    REQUIRE(ground.size() == cur.size());
+    int road = 0, other = 0;
+    for (std::size_t i = 0; i < cur.size(); ++i) {
+      const bool on_road = std::abs(cam.unproject({cur.keypoints[i].x, cur.keypoints[i].y}, cur.depth[i]).y() - 1.65) < 1e-3;
+      road += on_road && ground[i] ? 1 : 0;
+      other += !on_road && ground[i] ? 1 : 0;
+    }
+    CHECK(road == 40);
+    CHECK(other == 0);
+    rgbl::TrackerOptions strict = options;
+    strict.ground_min_points = 60;
+    CHECK(rgbl::ground_keypoints(cam, cur, strict).empty());
   }
   SECTION("without a road plane (too few points on it) coverage decides again") {
     rgbl::TrackerOptions strict = options;

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <optional>
+#include <vector>
 
 namespace rgbl {
 
@@ -35,9 +36,26 @@ inline double depth_tolerance(double z, const TrackerOptions& options) {
   return std::max(options.ransac_min_tolerance, options.ransac_relative_tolerance * z);
 }
 
+// Per keypoint of `frame`: with depth and on the dominant ground plane (options.ground_*, the plane
+// estimate_frame_motion ranks a consensus by). Empty when no such plane holds ground_min_points.
+std::vector<bool> ground_keypoints(const PinholeCamera& camera, const Frame& frame, const TrackerOptions& options);
+
+// A second rigid motion among the matches (see `rival` below).
+struct RivalMotion {
+  Eigen::Isometry3d T_cur_last = Eigen::Isometry3d::Identity();
+  std::vector<bool> moving;  // as `moving`, against this motion
+  std::size_t inliers = 0;
+};
+
+// With `rival` given, no prior and a motion found: the best consensus of at least
+// ransac_min_inliers among the matches the winner leaves out (a second RANSAC on them), if any.
+// Without a prior the largest rigid consensus may be an object moving with the camera (a car ahead at
+// the ego speed keeps its look while the scene's matches fade with distance travelled), so the caller
+// should let other evidence (the local map) choose between the two.
 std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& camera, const Frame& last, const Frame& frame,
                                                        const TrackerOptions& options,
                                                        const std::optional<Eigen::Isometry3d>& prior = std::nullopt,
-                                                       std::vector<bool>* moving = nullptr);
+                                                       std::vector<bool>* moving = nullptr,
+                                                       std::optional<RivalMotion>* rival = nullptr);
 
 }  // namespace rgbl

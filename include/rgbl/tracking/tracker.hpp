@@ -119,9 +119,15 @@ class Tracker {
   std::optional<Eigen::Isometry3d> trusted_velocity() const {
     return options_.ransac_motion_prior && velocity_steady_ ? velocity_ : std::nullopt;
   }
-  // Matches the reference keyframe's points by descriptor and optimises the pose. weak_start receives a
-  // second result, from a depth consensus too weak to be the only start, when that converged too.
-  bool track_reference_keyframe(Frame& frame, std::optional<Frame>& weak_start) const;
+  // Another start against the reference keyframe: from a depth consensus too weak to be the only
+  // start, or (rival) from a second rigid motion among the matches.
+  struct OtherStart {
+    Frame frame;
+    bool rival = false;
+  };
+  // Matches the reference keyframe's points by descriptor and optimises the pose. `others` receives the
+  // other starts that converged too (the weak consensus first).
+  bool track_reference_keyframe(Frame& frame, std::vector<OtherStart>& others) const;
   // Unmatches keypoints labelled moving and those whose landmark disagrees with frame.T_cam_world (a
   // depth-consensus prediction; see disagrees_with_pose).
   void drop_moving_matches(Frame& frame, double slack = 0.0) const;
