@@ -13,6 +13,7 @@
 #include <charconv>
 #include <system_error>
 #include <cmath>
+#include <fstream>
 #include <limits>
 
 namespace rgbl {
@@ -66,7 +67,12 @@ cv::Mat_<float> read_depth_png(const std::filesystem::path& file) {
 void write_depth_png(const std::filesystem::path& file, const cv::Mat_<float>& depth) {
   cv::Mat raw;
   depth.convertTo(raw, CV_16U, 256.0);  // saturating
-  if (!cv::imwrite(file.string(), raw)) throw ParseError(file, 0, "a writable PNG path");
+  std::vector<unsigned char> png;
+  if (!cv::imencode(".png", raw, png)) throw ParseError(file, 0, "a depth map that encodes as PNG");
+  // atomically: a reader (a run using --depth precomputed) never sees half a map
+  write_atomically(file, [&](std::ofstream& out) {
+    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  });
 }
 
 void sample_dense_depth(const cv::Mat_<float>& dense, const Kernel& kernel, std::span<const Eigen::Vector2f> pixels,

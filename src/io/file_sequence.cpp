@@ -10,7 +10,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <fstream>
 #include <utility>
+#include <vector>
 
 namespace rgbl::detail {
 namespace {
@@ -145,6 +147,17 @@ void require_frames(const std::filesystem::path& dir, std::size_t count, int dig
 }  // namespace rgbl::detail
 
 namespace rgbl {
+
+void write_png_file(const std::filesystem::path& file, const cv::Mat& image) {
+  std::vector<unsigned char> png;
+  if (image.empty() || !cv::imencode(".png", image, png)) {
+    throw Error(fmt::format("{}: cannot encode a PNG of this image ({}x{}, type {})", file.string(), image.cols,
+                            image.rows, image.type()));
+  }
+  write_atomically(file, [&](std::ofstream& out) {
+    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  });
+}
 
 cv::Mat read_image_file(const std::filesystem::path& file, int flags) {
   constexpr std::string_view kWhat = "an image file";

@@ -1,6 +1,8 @@
 #include "rgbl/pipeline/depth_export.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/file.hpp"
+#include "rgbl/io/image.hpp"
 #include "rgbl/core/timer.hpp"
 #include "rgbl/depth/completion.hpp"
 
@@ -72,6 +74,7 @@ void DepthExportOptions::validate() const {
 DepthExportResult export_depth(const Pipeline& p, const std::filesystem::path& out,
                                const DepthExportOptions& options) {
   options.validate();
+  const OutputFolder folder(out);  // checked and locked before the first frame, as a run's --out
   std::filesystem::create_directories(out / "depth");
   std::filesystem::create_directories(out / "preview");
   auto source = p.make_depth_source();
@@ -94,9 +97,7 @@ DepthExportResult export_depth(const Pipeline& p, const std::filesystem::path& o
     const std::string name = fmt::format("{:06d}.png", input->index);
     write_depth_png(out / "depth" / name, dense);
     const auto preview = out / "preview" / name;
-    if (!cv::imwrite(preview.string(), colourise(dense, options.preview_max_depth))) {
-      throw Error(fmt::format("{}: cannot write the preview", preview.string()));
-    }
+    write_png_file(preview, colourise(dense, options.preview_max_depth));
     cv::Mat_<float> truth;
     if (!input->depth.empty() && p.depth_name() != "rgbd") {
       truth = input->depth;

@@ -1,5 +1,6 @@
 // Writing a synthetic sequence in KITTI odometry layout.
 #include "rgbl/core/error.hpp"
+#include "rgbl/io/image.hpp"
 #include "rgbl/sim/synthetic.hpp"
 
 #include <fmt/format.h>
@@ -46,7 +47,7 @@ class SequenceWriter {
     const std::string name = fmt::format("{:06d}", f.index);
     for (int c = 0; c < 4; ++c) {
       const cv::Mat& image = f.images[static_cast<std::size_t>(c)];
-      if (!image.empty()) write_png(layout_.sequence_dir / fmt::format("image_{}", c) / (name + ".png"), image);
+      if (!image.empty()) write_png_file(layout_.sequence_dir / fmt::format("image_{}", c) / (name + ".png"), image);
     }
     if (!f.depth.empty()) write_depth(layout_.sequence_dir / "depth" / (name + ".png"), f.depth);
     const auto bin = layout_.sequence_dir / "velodyne" / (name + ".bin");
@@ -86,12 +87,9 @@ class SequenceWriter {
         depth16.at<std::uint16_t>(v, u) = scaled > 0.0 && scaled <= 65535.0 ? static_cast<std::uint16_t>(scaled) : 0;
       }
     }
-    write_png(file, depth16);
+    write_png_file(file, depth16);
   }
 
-  static void write_png(const std::filesystem::path& file, const cv::Mat& image) {
-    if (!cv::imwrite(file.string(), image)) throw Error(fmt::format("cannot write {}", file.string()));
-  }
 
   void write_calibration(const KittiCalibration& calibration) const {
     const auto file = layout_.sequence_dir / "calib.txt";

@@ -10,9 +10,11 @@
 #include <cmath>
 #include <condition_variable>
 #include <deque>
+#include <exception>
 #include <mutex>
 #include <optional>
 #include <shared_mutex>
+#include <stdexcept>
 #include <thread>
 
 namespace rgbl {
@@ -117,6 +119,34 @@ struct System::Impl {
   mutable std::mutex results_mutex;  // guards closures, reported, stats while the loop thread runs
   std::size_t reported = 0;          // closures already handed to a TrackResult
   LoopClosingStats stats;            // the loop thread's, after its last keyframe
+  // The first exception of a worker thread (guarded by results_mutex); from then on the workers
+  // discard their jobs, and the caller's thread rethrows it.
+  std::exception_ptr worker_error;
+
+  // Runs a worker's job unless a worker has failed; keeps the first exception.
+  template <class F>
+  bool run_job(F&& job) {
+    {
+      std::lock_guard lock(results_mutex);
+      if (worker_error) return false;
+    }
+    try {
+      job();
+      return true;
+    } catch (...) {
+      std::lock_guard lock(results_mutex);
+      if (!worker_error) worker_error = std::current_exception();
+      return false;
+    }
+  }
+  void rethrow_worker_error() const {
+    std::exception_ptr error;
+    {
+      std::lock_guard lock(results_mutex);
+      error = worker_error;
+    }
+    if (error) std::rethrow_exception(error);
+  }
 
   Impl(SystemOptions o, CameraCalibration c, std::unique_ptr<DepthSource> d, FeatureExtractor e)
       : options(o), calibration(c), map(o.map), tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping),
@@ -130,37 +160,41 @@ struct System::Impl {
   void run_mapping() {
     // drains the queue when stopped (local mapping aborts its bundle adjustment to be quick)
     while (std::optional<KeyframeJob> next = mapping_queue.pop(/*drain=*/true)) {
-      {
+      const bool mapped = run_job([&] {
         std::lock_guard gate(mapping_gate);
         mapper.process(next->keyframe);
-      }
-      if (threaded_loop_closing()) loop_queue.push(std::move(*next));  // before done(): finish() sees it
+      });
+      // before done(): finish() sees it
+      if (mapped && threaded_loop_closing()) loop_queue.push(std::move(*next));
       mapping_queue.done();
     }
   }
 
   void run_loop_closing() {
     while (std::optional<KeyframeJob> next = loop_queue.pop(/*drain=*/false)) {
-      std::optional<DetectedLoop> loop;
-      LoopCloserStep step = closer.detect(map, next->keyframe, next->scan, loop);
-      if (loop) {
-        std::scoped_lock gates(mapping_gate, tracking_gate);
-        std::optional<Eigen::Isometry3d> T_ref_world_before;
-        {
-          std::unique_lock lock(map.mutex());
-          T_ref_world_before = map.keyframe_pose(tracker.reference_keyframe());
-          closer.correct(map, *loop, step);
-        }
-        // tracking waits at its gate: its last frames follow the reference keyframe here
-        if (step.closure && T_ref_world_before) tracker.follow_map_correction(*T_ref_world_before);
-      }
-      {
-        std::lock_guard lock(results_mutex);
-        stats = closer.stats();
-        if (step.closure) closures.push_back(std::move(*step.closure));
-      }
+      run_job([&] { close_loops(*next); });
       loop_queue.done();
     }
+  }
+
+  // Detection beside tracking and mapping; a correction behind both gates.
+  void close_loops(const KeyframeJob& job) {
+    std::optional<DetectedLoop> loop;
+    LoopCloserStep step = closer.detect(map, job.keyframe, job.scan, loop);
+    if (loop) {
+      std::scoped_lock gates(mapping_gate, tracking_gate);
+      std::optional<Eigen::Isometry3d> T_ref_world_before;
+      {
+        std::unique_lock lock(map.mutex());
+        T_ref_world_before = map.keyframe_pose(tracker.reference_keyframe());
+        closer.correct(map, *loop, step);
+      }
+      // tracking waits at its gate: its last frames follow the reference keyframe here
+      if (step.closure && T_ref_world_before) tracker.follow_map_correction(*T_ref_world_before);
+    }
+    std::lock_guard lock(results_mutex);
+    stats = closer.stats();
+    if (step.closure) closures.push_back(std::move(*step.closure));
   }
 
   bool mapping_idle() const { return !options.threaded_mapping || mapping_queue.idle(); }
@@ -204,16 +238,24 @@ System::~System() {
   }
 }
 
+void System::add_place_recognizer(std::unique_ptr<PlaceRecognizer> recognizer) {
+  // the loop thread reads the recognisers once frames come: no lock, so only before
+  if (!impl_->records.empty()) throw std::logic_error("System::add_place_recognizer: only before the first frame");
+  impl_->closer.add_place_recognizer(std::move(recognizer));
+}
+
 void System::finish() {
   if (!impl_->options.threaded_mapping) return;
   impl_->mapping_queue.wait_idle();
   impl_->loop_queue.wait_idle();  // mapping has handed over its last keyframe
+  impl_->rethrow_worker_error();
 }
 
 TrackResult System::track(const SensorFrame& sensor) { return track(sensor, impl_->builder.build(sensor)); }
 
 TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   Impl& s = *impl_;
+  s.rethrow_worker_error();
   TrackResult result;
   result.frame_index = sensor.index;
   result.timestamp = sensor.timestamp;

@@ -121,6 +121,23 @@ if(FLOCK)
   if(NOT EXISTS ${out_dir}/trajectory_kitti.txt OR NOT EXISTS ${out_dir}/summary.json)
     message(FATAL_ERROR "the refused run removed the outputs of the run writing there")
   endif()
+  # rgbl depth takes the same lock, before it writes anything
+  execute_process(COMMAND ${FLOCK} ${out_dir} ${RGBL} --quiet depth ${WORK_DIR}/data/sequences/00 --out ${out_dir}
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  message("depth into a locked folder\n  exit ${rc}: ${err}")
+  if(rc EQUAL 0 OR NOT err MATCHES "error: [^\n]*out: another rgbl process is writing into this output folder")
+    message(FATAL_ERROR "rgbl depth into a folder being written was not refused")
+  endif()
+  if(EXISTS ${out_dir}/depth)
+    message(FATAL_ERROR "the refused rgbl depth wrote into the locked folder")
+  endif()
+  expect_success(--quiet depth ${WORK_DIR}/data/sequences/00 --out ${out_dir})
+  file(GLOB left ${out_dir}/depth/*.part ${out_dir}/preview/*.part)
+  file(GLOB maps ${out_dir}/depth/*.png)
+  list(LENGTH maps n_maps)
+  if(left OR NOT n_maps EQUAL 6)
+    message(FATAL_ERROR "rgbl depth: expected 6 maps and no temporary files, got ${n_maps} maps, left: ${left}")
+  endif()
   # and an unwritable --out is refused before the run
   file(WRITE ${WORK_DIR}/a_file "x")
   expect_failure("a_file/out: cannot create the output folder" --quiet run ${WORK_DIR}/data/sequences/00 --out

@@ -8,8 +8,16 @@
 #include "loop/sim_frames.hpp"
 
 #include "rgbl/eval/trajectory_metrics.hpp"
+#include "rgbl/place/place_recognition.hpp"
 
 #include <catch2/catch.hpp>
+
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
 
 TEST_CASE("threaded mapping: seq 04 still tracked throughout") {
   const auto sequence = rgbl::test::kitti_seq04();
@@ -104,4 +112,59 @@ TEST_CASE("frame threads: frames built ahead on a pool, the same poses as one th
   o.frames = 12;
   // more threads than cores: the pool's helping waits under contention
   rgbl::test::check_thread_counts_agree(o, {3});
+}
+
+namespace {
+// A recogniser of the user's that fails: its exception must reach the caller of track() or finish().
+class FailingRecognizer final : public rgbl::PlaceRecognizer {
+ public:
+  std::string_view name() const override { return "failing"; }
+  std::vector<rgbl::PlaceCandidate> query(const rgbl::PlaceQuery&, const std::function<bool(std::size_t)>&,
+                                          std::size_t) const override {
+    throw std::runtime_error("failing recogniser: query");
+  }
+  void add(const rgbl::PlaceQuery&) override { throw std::runtime_error("failing recogniser: add"); }
+};
+}  // namespace
+
+TEST_CASE("threaded loop closing: an exception in the loop thread is rethrown to the caller, tracking stops cleanly") {
+  rgbl::SyntheticOptions sim;
+  sim.frames = 30;
+  sim.cameras = {true, false, false, false};
+  const rgbl::SyntheticGenerator generator(sim);
+  rgbl::SystemOptions options;
+  options.threaded_mapping = true;
+  rgbl::DepthSourceContext depth;
+  depth.calibration = generator.calibration().camera(0);
+  auto orb = std::make_shared<rgbl::OrbExtractor>();
+  auto system = std::make_unique<rgbl::System>(
+      options, depth.calibration, rgbl::make_lidar_source({}, depth),
+      [orb](const cv::Mat& gray, std::vector<rgbl::Keypoint>& kps, std::vector<rgbl::Descriptor>& desc) {
+        orb->extract(gray, kps, desc);
+      });
+  system->add_place_recognizer(std::make_unique<FailingRecognizer>());
+  std::string error;
+  std::size_t tracked = 0;
+  try {
+    for (int i = 0; i < sim.frames; ++i) {
+      const rgbl::FrameInput input = rgbl::test::render_frame(generator, i);
+      rgbl::SensorFrame frame;
+      frame.index = static_cast<std::size_t>(i);
+      frame.timestamp = input.timestamp;
+      frame.image = input.images[0];
+      frame.scan = input.scan;
+      system->track(frame);
+      ++tracked;
+    }
+    system->finish();
+  } catch (const std::runtime_error& e) {
+    error = e.what();
+  }
+  INFO(tracked << " frames tracked before the error");
+  CHECK(error.starts_with("failing recogniser"));
+  // the system can still be asked and destroyed (the threads stop, nothing hangs)
+  CHECK(system->trajectory().size() == tracked);
+  CHECK_THROWS_AS(system->add_place_recognizer(std::make_unique<FailingRecognizer>()), std::logic_error);
+  CHECK_THROWS_WITH(system->finish(), Catch::Matchers::StartsWith("failing recogniser"));
+  system.reset();
 }

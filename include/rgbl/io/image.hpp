@@ -1,5 +1,5 @@
 #pragma once
-// Reading one image file, as every dataset loader does.
+// Reading one image file, as every dataset loader does, and writing one as every writer does.
 
 #include <opencv2/core/mat.hpp>
 
@@ -12,5 +12,9 @@ namespace rgbl {
 // header before decoding; see rgbl/core/file.hpp). Throws ParseError naming the file otherwise or when
 // it cannot be decoded; never returns an empty image.
 cv::Mat read_image_file(const std::filesystem::path& file, int flags);
+
+// Encodes `image` as PNG and writes it through write_atomically (rgbl/core/file.hpp): a reader never
+// sees half a file, an interrupted writer leaves none. Throws Error naming the file.
+void write_png_file(const std::filesystem::path& file, const cv::Mat& image);
 
 }  // namespace rgbl

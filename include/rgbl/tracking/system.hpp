@@ -91,15 +91,21 @@ class System {
   System(const System&) = delete;
   System& operator=(const System&) = delete;
 
-  // Throws only what the depth source throws on unusable input (e.g. no right image for the stereo
-  // source); a frame without depth (e.g. a dropped LiDAR scan) is tracked on the map alone.
+  // Adds a place recogniser of your own to loop closing (see LoopCloser::add_place_recognizer).
+  // Before the first frame: std::logic_error after it.
+  void add_place_recognizer(std::unique_ptr<PlaceRecognizer> recognizer);
+
+  // Throws what the depth source throws on unusable input (e.g. no right image for the stereo
+  // source); a frame without depth (e.g. a dropped LiDAR scan) is tracked on the map alone. With
+  // threaded mapping, an exception thrown in the mapping or loop-closing thread (e.g. by a recogniser
+  // of your own) stops that thread's work and is rethrown here, at the next frame, or by finish().
   TrackResult track(const SensorFrame& frame);
   // The same with the frame built beforehand (e.g. on another thread, by a FrameBuilder of its own):
   // `sensor` is the frame it was built from, still needed for its scan (loop closing).
   TrackResult track(const SensorFrame& sensor, PreparedFrame prepared);
 
   // Waits until threaded mapping and loop closing have processed every queued keyframe (no-op when
-  // inline); the trajectory then includes every correction.
+  // inline); the trajectory then includes every correction. Rethrows a worker thread's exception.
   void finish();
 
   // Every frame so far, with poses refined by mapping (frames are stored relative to their reference
