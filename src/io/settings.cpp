@@ -142,14 +142,16 @@ Settings read_settings(const std::filesystem::path& yaml) {
   //   sets the top-level map's indentation), so it is refused with its line.
   // It also recurses once per nesting level and overflows the stack on deep nesting ('[' x 50000):
   // settings are flat, so nesting beyond kMaxNesting levels (flow brackets, indentation and "- " items)
-  // is refused with its line. And it keeps the last of two equal keys: each top-level key once.
+  // is refused with its line. And it keeps the last of two equal keys: each key once per map, at the
+  // top level and in nested block maps (e.g. an !!opencv-matrix's rows, cols and data).
   {
     constexpr std::size_t kMaxNesting = 64;
     std::size_t line_no = 0, markers = 0, pos = 0;
     std::optional<std::pair<std::size_t, std::size_t>> first_key;  // (indentation, line)
     std::size_t flow = 0;                 // open '[' and '{' (they may span lines)
     std::vector<std::size_t> indents;     // indentation of the enclosing block levels
-    std::map<std::string, std::size_t> top_keys;  // key -> line
+    // the block maps open at this line, innermost last: (indentation, key -> line)
+    std::vector<std::pair<std::size_t, std::map<std::string, std::size_t>>> maps;
     while (pos < text.size()) {
       const std::size_t end = std::min(text.find('\n', pos), text.size());
       std::string_view line(text.data() + pos, end - pos);
@@ -177,7 +179,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
                                      "found {} spaces",
                                      first_key->second, first_key->first, indent));
       }
-      const bool top_level = flow == 0 && indent == first_key->first;
+      const bool block_line = flow == 0;  // not inside a flow collection spanning lines
       // block nesting: indentation levels, and "- - x" items nested on one line
       if (flow == 0) {
         while (!indents.empty() && indents.back() >= indent) indents.pop_back();
@@ -209,13 +211,23 @@ Settings read_settings(const std::filesystem::path& yaml) {
         throw ParseError(yaml, line_no,
                          fmt::format("nested deeper than {} levels (expected flat 'Key: value' settings)", kMaxNesting));
       }
-      if (top_level && items == 0) {
-        std::string_view key = content.substr(0, content.find(':'));
+      // a line closes the maps indented deeper (also a new item of a sequence: those of the item before)
+      if (block_line) {
+        while (!maps.empty() && maps.back().first > indent) maps.pop_back();
+      }
+      const std::size_t colon = content.find(':');
+      const bool quoted_key = content.starts_with('"') || content.starts_with('\'');
+      if (block_line && items == 0 && colon != std::string_view::npos && !content.starts_with('[') &&
+          !content.starts_with('{') &&
+          (colon + 1 == content.size() || content[colon + 1] == ' ' || content[colon + 1] == '\t' ||
+           content[colon + 1] == '\r' || quoted_key)) {
+        std::string_view key = content.substr(0, colon);
         while (!key.empty() && (key.back() == ' ' || key.back() == '\t')) key.remove_suffix(1);
         if (key.size() >= 2 && (key.front() == '"' || key.front() == '\'') && key.back() == key.front()) {
           key = key.substr(1, key.size() - 2);
         }
-        const auto [it, inserted] = top_keys.emplace(std::string(key), line_no);
+        if (maps.empty() || maps.back().first < indent) maps.emplace_back(indent, std::map<std::string, std::size_t>{});
+        const auto [it, inserted] = maps.back().second.emplace(std::string(key), line_no);
         if (!inserted) {
           throw ParseError(yaml, line_no,
                            fmt::format("key '{}' given twice (lines {} and {}); expected each key once", key,

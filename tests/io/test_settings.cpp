@@ -240,6 +240,15 @@ TEST_CASE("settings: deep nesting, duplicate keys and byte order marks", "[io][s
   CHECK_THAT(error_of(tmp.write("dup.yaml", "%YAML:1.0\nORBextractor.nFeatures: 100\n# again\n"
                                             "ORBextractor.nFeatures: 200\n")),
              Contains("dup.yaml:4: key 'ORBextractor.nFeatures' given twice (lines 2 and 4)"));
+  // ... and so did equal keys in a nested map (a matrix's); the same key in two maps is fine
+  const std::string matrix = "%YAML:1.0\nORBextractor.nFeatures: 100\nTr: !!opencv-matrix\n  rows: 3\n  cols: 4\n"
+                             "  rows: 4\n  dt: d\n  data: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0]\n";
+  CHECK_THAT(error_of(tmp.write("nested.yaml", matrix)),
+             Contains("nested.yaml:6: key 'rows' given twice (lines 4 and 6)"));
+  const auto two_maps = tmp.write("two_maps.yaml", "%YAML:1.0\nA:\n  rows: 1\n  x:\n    rows: 2\nB:\n  rows: 3\n"
+                                                   "list:\n  - rows: 1\n    cols: 2\n  - rows: 1\n    cols: 2\n"
+                                                   "ORBextractor.nFeatures: 300\n");
+  CHECK(rgbl::read_settings(two_maps).orb.n_features == 300);
   // a UTF-8 byte order mark (Windows editors) is skipped
   const auto bom = rgbl::read_settings(tmp.write("bom.yaml", "\xEF\xBB\xBFORBextractor.nFeatures: 1000\n"));
   CHECK(bom.orb.n_features == 1000);
