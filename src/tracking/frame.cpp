@@ -67,6 +67,7 @@ void TrackerOptions::validate() const {
           "tracker.step_tolerance_rotation_deg", "in [0, 180] degrees");
   require(min_jump_inliers >= min_pose_inliers, "tracker.min_jump_inliers", ">= tracker.min_pose_inliers");
   require(max_frames_between_keyframes >= 1, "tracker.max_frames_between_keyframes", ">= 1");
+  require(max_queued_keyframes >= 1, "tracker.max_queued_keyframes", ">= 1");
   require(reference_ratio_threshold > 0.0 && reference_ratio_threshold <= 1.0, "tracker.reference_ratio_threshold",
           "in (0, 1]");
   require(initial_reference_ratio_threshold > 0.0 && initial_reference_ratio_threshold <= 1.0,

@@ -18,14 +18,20 @@ LocalMapper::LocalMapper(Map& map, const PinholeCamera& camera, LocalMappingOpti
   options_.validate();
 }
 
-LocalMappingStats LocalMapper::process(KeyframeId keyframe) {
+LocalMappingStats LocalMapper::process(KeyframeId keyframe, const std::vector<LandmarkId>& created_with_keyframe) {
   LocalMappingStats stats;
   abort_ = false;
   {
     std::unique_lock lock(map_.mutex());
     associate(keyframe);
     stats.culled_landmarks = cull_landmarks(keyframe);
-    stats.new_landmarks = create_depth_landmarks(keyframe);
+    for (const LandmarkId l : created_with_keyframe) {
+      if (map_.landmark(l) != nullptr) recent_landmarks_.push_back(l);
+    }
+    const int budget = options_.max_new_depth_points - static_cast<int>(created_with_keyframe.size());
+    const std::vector<LandmarkId> created = create_depth_landmarks(map_, camera_, keyframe, std::max(budget, 0));
+    recent_landmarks_.insert(recent_landmarks_.end(), created.begin(), created.end());
+    stats.new_landmarks = static_cast<int>(created_with_keyframe.size() + created.size());
     if (options_.fusion) stats.fused_landmarks = fuse(keyframe);
   }
   if (options_.local_ba) stats.ba_outliers = local_bundle_adjustment(keyframe, stats.ba_ms);
@@ -64,25 +70,24 @@ int LocalMapper::cull_landmarks(KeyframeId current) {
   return culled;
 }
 
-int LocalMapper::create_depth_landmarks(KeyframeId id) {
-  Keyframe* kf = map_.keyframe(id);
-  if (kf == nullptr) return 0;
+std::vector<LandmarkId> create_depth_landmarks(Map& map, const PinholeCamera& camera, KeyframeId id, int max_points) {
+  std::vector<LandmarkId> created;
+  const Keyframe* kf = map.keyframe(id);
+  if (kf == nullptr) return created;
   std::vector<std::pair<float, std::size_t>> candidates;
   for (std::size_t i = 0; i < kf->keypoints.size(); ++i) {
     if (kf->depth_sigma[i] > 0.0F && !kf->landmarks[i].valid()) candidates.emplace_back(kf->depth[i], i);
   }
   std::sort(candidates.begin(), candidates.end());
   const Eigen::Isometry3d T_world_cam = kf->T_cam_world.inverse();
-  int created = 0;
   for (const auto& [z, i] : candidates) {
-    if (created >= options_.max_new_depth_points) break;
-    const Eigen::Vector3d p = camera_.unproject(Eigen::Vector2d(kf->keypoints[i].x, kf->keypoints[i].y), z);
-    const LandmarkId l = map_.add_landmark(T_world_cam * p, id);
-    map_.add_observation(l, id, static_cast<int>(i));
-    map_.update_landmark(l);
-    recent_landmarks_.push_back(l);
-    ++created;
-    kf = map_.keyframe(id);
+    if (static_cast<int>(created.size()) >= max_points) break;
+    const Eigen::Vector3d p = camera.unproject(Eigen::Vector2d(kf->keypoints[i].x, kf->keypoints[i].y), z);
+    const LandmarkId l = map.add_landmark(T_world_cam * p, id);
+    map.add_observation(l, id, static_cast<int>(i));
+    map.update_landmark(l);
+    created.push_back(l);
+    kf = map.keyframe(id);
   }
   return created;
 }

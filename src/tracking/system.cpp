@@ -69,6 +69,10 @@ class WorkQueue {
     std::lock_guard lock(mutex_);
     return !busy_ && jobs_.empty();
   }
+  std::size_t queued() const {  // not counting the one in hand
+    std::lock_guard lock(mutex_);
+    return jobs_.size();
+  }
   void wait_idle() {
     std::unique_lock lock(mutex_);
     idle_.wait(lock, [&] { return !busy_ && jobs_.empty(); });
@@ -107,6 +111,7 @@ struct System::Impl {
   struct KeyframeJob {
     KeyframeId keyframe;
     std::vector<LidarPoint> scan;
+    std::vector<LandmarkId> depth_landmarks;  // made with the keyframe (threaded mapping)
   };
 
   // Threaded mapping, and loop closing (with threaded mapping) fed by it once a keyframe is mapped.
@@ -162,7 +167,7 @@ struct System::Impl {
     while (std::optional<KeyframeJob> next = mapping_queue.pop(/*drain=*/true)) {
       const bool mapped = run_job([&] {
         std::lock_guard gate(mapping_gate);
-        mapper.process(next->keyframe);
+        mapper.process(next->keyframe, next->depth_landmarks);
       });
       // before done(): finish() sees it
       if (mapped && threaded_loop_closing()) loop_queue.push(std::move(*next));
@@ -271,7 +276,8 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
 
   // A loop thread's correction waits for this frame to be tracked and recorded (uncontended inline).
   const std::lock_guard gate(s.tracking_gate);
-  const TrackerOutcome outcome = s.tracker.track(frame, s.mapping_idle());
+  const TrackerOutcome outcome =
+      s.tracker.track(frame, s.mapping_idle(), s.options.threaded_mapping ? s.mapping_queue.queued() : 0);
   KeyframeId new_keyframe;
   if (outcome.need_keyframe) new_keyframe = s.tracker.make_keyframe(frame);
   result.timing.tracking_ms = stage.lap_ms();
@@ -283,7 +289,14 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   };
   if (new_keyframe.valid()) {
     if (s.options.threaded_mapping) {
-      s.mapping_queue.push({new_keyframe, scan_copy()});
+      // The keyframe's depth points become landmarks now, on this thread: the next frames track
+      // against them even while local mapping lags behind (ORB-SLAM does the same for RGB-D).
+      std::vector<LandmarkId> created;
+      {
+        std::unique_lock lock(s.map.mutex());
+        created = create_depth_landmarks(s.map, s.calibration.camera, new_keyframe, s.options.mapping.max_new_depth_points);
+      }
+      s.mapping_queue.push({new_keyframe, scan_copy(), std::move(created)});
     } else {
       s.mapper.process(new_keyframe);
     }

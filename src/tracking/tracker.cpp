@@ -69,7 +69,7 @@ int count_tracked(const Frame& frame) {
 
 // Hypotheses are built as values by const members (first, maybe relocalisation, maybe the step
 // check's), the chosen one is committed once: nothing but commit() and initialisation changes state.
-TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
+TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle, std::size_t keyframes_queued) {
   TrackerOutcome outcome;
   frame.landmarks.assign(frame.size(), LandmarkId{});
   frame.outlier.assign(frame.size(), false);
@@ -103,7 +103,7 @@ TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle) {
   if (h.ok && options_.check_steps && velocity_steady_ && has_pose(state_) && last_frame_ && !h.relocalised) {
     h = step_hypothesis(std::move(h), prediction, views);
   }
-  commit(h, prediction, first, views, mapping_idle, outcome);
+  commit(h, prediction, first, views, mapping_idle, keyframes_queued, outcome);
   frame = std::move(h.frame);
   if (outcome.new_map) return finish_initialised(frame, outcome);
   last_frame_ = frame;
@@ -285,7 +285,7 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
 }
 
 void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHypothesis& first, const ViewLog& views,
-                     bool mapping_idle, TrackerOutcome& outcome) {
+                     bool mapping_idle, std::size_t keyframes_queued, TrackerOutcome& outcome) {
   {
     std::unique_lock lock(map_.mutex());
     for (const LandmarkId id : views.visible) {
@@ -313,8 +313,11 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
       velocity_dt_ = frame.timestamp - last_frame_->timestamp;
       velocity_steady_ = consecutive && first.motion_ok && !h.relocalised;
     }
-    // a frame placed at the prediction has no observations worth a keyframe
-    outcome.need_keyframe = !h.step_rejected && (h.weak || need_keyframe(frame, inliers, mapping_idle));
+    // a frame placed at the prediction has no observations worth a keyframe; a full mapping queue
+    // takes none (those waiting refresh the map soon)
+    outcome.need_keyframe = !h.step_rejected &&
+                            keyframes_queued < static_cast<std::size_t>(options_.max_queued_keyframes) &&
+                            (h.weak || need_keyframe(frame, inliers, mapping_idle));
   } else {
     const bool was_lost = state_ == TrackState::Lost;
     logger()->debug("frame {}: lost: frame-to-frame motion {} inliers ({} needed), local map {} of {} points in view "

@@ -194,7 +194,8 @@ class Pipeline {
 const std::vector<std::string>& run_output_files();
 
 // Removes an earlier run's outputs from `out_dir` (an output left over from it would look like this
-// run's if this one fails).
+// run's if this one fails), and the temporaries (<name>.<random>.part) of a run killed while writing
+// them. Call it holding the folder (OutputFolder).
 void remove_run_outputs(const std::filesystem::path& out_dir);
 
 // Writes into `out_dir` (created, and locked against other processes while writing: OutputFolder):

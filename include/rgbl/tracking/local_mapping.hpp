@@ -21,19 +21,26 @@ struct LocalMappingStats {
   double ba_ms = 0.0;
 };
 
+// Landmarks at the keyframe's keypoints with depth that have none, nearest first, at most max_points
+// (RGB-D: a metric point needs no second view). The caller holds the map lock exclusively.
+std::vector<LandmarkId> create_depth_landmarks(Map& map, const PinholeCamera& camera, KeyframeId keyframe,
+                                               int max_points);
+
 class LocalMapper {
  public:
   LocalMapper(Map& map, const PinholeCamera& camera, LocalMappingOptions options);
 
-  // Processes a keyframe already added to the map; takes the map lock itself.
-  LocalMappingStats process(KeyframeId keyframe);
+  // Processes a keyframe already added to the map; takes the map lock itself. created_with_keyframe:
+  // depth landmarks the caller made with the keyframe (create_depth_landmarks, threaded mapping: so
+  // that tracking finds the new points at the next frame, not once mapping catches up); they count
+  // against max_new_depth_points, and keypoints left without a landmark by culling get new ones.
+  LocalMappingStats process(KeyframeId keyframe, const std::vector<LandmarkId>& created_with_keyframe = {});
 
   // Asks a running bundle adjustment to stop early (e.g. when a new keyframe is waiting).
   void request_abort() { abort_ = true; }
 
  private:
   void associate(KeyframeId keyframe);
-  int create_depth_landmarks(KeyframeId keyframe);
   int cull_landmarks(KeyframeId keyframe);
   int fuse(KeyframeId keyframe);
   int local_bundle_adjustment(KeyframeId keyframe, double& elapsed_ms);

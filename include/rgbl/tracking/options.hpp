@@ -128,6 +128,10 @@ struct TrackerOptions {
   double urgent_reference_ratio = 0.25;
   int close_tracked_threshold = 100, close_untracked_threshold = 70;
   int min_keyframe_inliers = 15;
+  // Threaded mapping: no keyframe while this many wait for local mapping (ORB-SLAM's 3). Without the
+  // cap a lagging mapper leaves the map thin, thin maps make every frame a keyframe, and the queue
+  // grows without end.
+  int max_queued_keyframes = 3;
   double close_depth = 97.0;            // m; "close" points (RGB-L: bf/fx * ThDepth = 100/707 * 700)
 
   PoseOptimizerOptions pose;

@@ -38,8 +38,9 @@ class Tracker {
   Tracker(Map& map, const PinholeCamera& camera, TrackerOptions options);
 
   // Tracks the frame (sets frame.T_cam_world, landmarks, outliers). When initialised_now or
-  // need_keyframe, the caller turns the frame into a keyframe with make_keyframe().
-  TrackerOutcome track(Frame& frame, bool mapping_idle);
+  // need_keyframe, the caller turns the frame into a keyframe with make_keyframe(). mapping_idle and
+  // keyframes_queued: local mapping's state (threaded; inline it is always idle with none queued).
+  TrackerOutcome track(Frame& frame, bool mapping_idle, std::size_t keyframes_queued = 0);
 
   // Adds the frame as a keyframe to the map (taking the map lock) and makes it the reference.
   KeyframeId make_keyframe(const Frame& frame);
@@ -105,7 +106,7 @@ class Tracker {
   Hypothesis step_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const;
   // Makes the chosen hypothesis the tracker's state (the only place track() changes it).
   void commit(Hypothesis& h, const Prediction& prediction, const FirstHypothesis& first, const ViewLog& views,
-              bool mapping_idle, TrackerOutcome& outcome);
+              bool mapping_idle, std::size_t keyframes_queued, TrackerOutcome& outcome);
 
   bool initialise(Frame& frame, const Eigen::Isometry3d& T_cam_world);
   // The frame started a map (the first, or a new one when lost): it is the last frame and tracked.
