@@ -1,6 +1,7 @@
 #pragma once
 // A real drive tracked with default settings for the loop tests: the map is the result.
 
+#include "support/sensor_frame.hpp"
 #include "rgbl/depth/sources.hpp"
 #include "rgbl/features/orb.hpp"
 #include "rgbl/io/sequence.hpp"
@@ -33,11 +34,8 @@ Mapped track_frames(const CameraCalibration& calibration, std::size_t count, Loa
                                       });
   for (std::size_t i = 0; i < count; ++i) {
     const FrameInput& input = load(i);  // a temporary lives until the end of this iteration
-    SensorFrame frame;
+    SensorFrame frame = sensor_frame(input);
     frame.index = i;
-    frame.timestamp = input.timestamp;
-    frame.image = input.images[0];
-    frame.scan = input.scan;
     m.results.push_back(m.system->track(frame));
   }
   m.system->finish();

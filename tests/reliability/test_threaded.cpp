@@ -3,6 +3,7 @@
 #include "reliability/failure_run.hpp"
 #include "tracking/kitti_run.hpp"
 #include "support/data.hpp"
+#include "support/sensor_frame.hpp"
 #include "support/thread_counts.hpp"
 #include "loop/mapped_drive.hpp"
 #include "loop/sim_frames.hpp"
@@ -149,12 +150,7 @@ TEST_CASE("threaded loop closing: an exception in the loop thread is rethrown to
   try {
     for (int i = 0; i < sim.frames; ++i) {
       const rgbl::FrameInput input = rgbl::test::render_frame(generator, i);
-      rgbl::SensorFrame frame;
-      frame.index = static_cast<std::size_t>(i);
-      frame.timestamp = input.timestamp;
-      frame.image = input.images[0];
-      frame.scan = input.scan;
-      system->track(frame);
+      system->track(rgbl::test::sensor_frame(input));
       ++tracked;
     }
     system->finish();
@@ -195,11 +191,7 @@ TEST_CASE("threaded mapping: a lagging mapper does not thin the map; keyframes s
   std::vector<rgbl::PreparedFrame> prepared;
   for (int i = 0; i < sim.frames; ++i) {
     const rgbl::FrameInput input = rgbl::test::render_frame(generator, i);
-    rgbl::SensorFrame frame;
-    frame.index = static_cast<std::size_t>(i);
-    frame.timestamp = input.timestamp;
-    frame.image = input.images[0];
-    frame.scan = input.scan;
+    rgbl::SensorFrame frame = rgbl::test::sensor_frame(input);
     prepared.push_back(builder.build(frame));
     frame.image = cv::Mat();
     frame.scan = {};  // only loop closing's scan context would use it

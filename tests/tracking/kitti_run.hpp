@@ -2,6 +2,7 @@
 // Runs the System on the real KITTI excerpt through the library's own loader and metrics, as
 // `rgbl run` does, for the tracking acceptance tests.
 
+#include "support/sensor_frame.hpp"
 #include "rgbl/depth/sources.hpp"
 #include "rgbl/eval/trajectory_metrics.hpp"
 #include "rgbl/features/orb.hpp"
@@ -37,11 +38,8 @@ inline SequenceRun run_sequence(const std::filesystem::path& dir, int camera, st
   run.frames = std::min(frames, sequence->size());
   for (std::size_t i = 0; i < run.frames; ++i) {
     const FrameInput input = sequence->load(i);
-    SensorFrame frame;
+    SensorFrame frame = sensor_frame(input, camera);
     frame.index = i;
-    frame.timestamp = input.timestamp;
-    frame.image = input.images[static_cast<std::size_t>(camera)];
-    frame.scan = input.scan;
     const TrackState state = system.track(frame).state;
     run.tracked += state == TrackState::Ok ? 1 : 0;
     run.with_pose += has_pose(state) ? 1 : 0;
