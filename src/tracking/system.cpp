@@ -307,7 +307,7 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   const KeyframeId loop_keyframe = outcome.initialised_now ? s.tracker.reference_keyframe() : new_keyframe;
   if (s.threaded_loop_closing()) {
     // the first keyframe is not mapped: straight to the loop thread; the others come from mapping
-    if (outcome.initialised_now && loop_keyframe.valid()) s.loop_queue.push({loop_keyframe, scan_copy()});
+    if (outcome.initialised_now && loop_keyframe.valid()) s.loop_queue.push({loop_keyframe, scan_copy(), {}});
     std::lock_guard lock(s.results_mutex);
     if (s.reported < s.closures.size()) result.loop_closure = s.closures[s.reported++];
   } else if (loop_keyframe.valid() && s.options.loop_closing.enabled) {
