@@ -87,7 +87,7 @@ TEST_CASE("map bundle: the whole map adjusted back to the truth, the held keyfra
   check_truth(1e-4, 1e-5);
 }
 
-TEST_CASE("map bundle: a window adds only its own landmarks; anchors add observations and stay fixed") {
+TEST_CASE("map bundle: a window adds only its own landmarks, anchors add observations and stay fixed") {
   rgbl::test::PointsMap s = rgbl::test::make_points_map(4, 80);
   std::vector<rgbl::KeyframeId> keyframes;
   std::vector<rgbl::LandmarkId> landmarks;

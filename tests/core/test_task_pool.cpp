@@ -66,7 +66,7 @@ TEST_CASE("task pool: nested parallelism and waiting inside a task do not deadlo
   }
 }
 
-TEST_CASE("task pool: a task destroyed unwaited is waited for; a one-thread pool runs tasks when waited", "[core][pool]") {
+TEST_CASE("task pool: a task destroyed unwaited is waited for, a one-thread pool runs tasks when waited", "[core][pool]") {
   rgbl::TaskPool single(1);
   int value = 0;
   {

@@ -98,7 +98,7 @@ TEST_CASE("KITTI metric: a constant yaw-rate error", "[eval][kitti]") {
   CHECK(rpe.translation.max < 1e-12);
 }
 
-TEST_CASE("metrics ignore the estimate's world frame; ATE aligns it away", "[eval][ate]") {
+TEST_CASE("metrics ignore the estimate's world frame, ATE aligns it away", "[eval][ate]") {
   const Poses gt = arc(200, 0.01);
   rgbl::Vector6d xi;
   xi << 3.0, -20.0, 7.0, 0.3, -1.1, 0.4;

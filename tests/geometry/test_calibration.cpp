@@ -88,7 +88,7 @@ TEST_CASE("calibration errors name the file, the line and what was expected") {
   }
 }
 
-TEST_CASE("calibration: implausible intrinsics, non-rigid Tr, duplicate keys refused; a byte order mark is skipped") {
+TEST_CASE("calibration: implausible intrinsics, non-rigid Tr, duplicate keys refused, a byte order mark is skipped") {
   rgbl::test::TempDir dir;
   const auto error_of = [&](const std::string& text, int width = 0, int height = 0) -> std::string {
     const auto file = dir.write("calib.txt", text);

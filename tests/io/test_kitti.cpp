@@ -236,7 +236,7 @@ TEST_CASE("KITTI loader: bad input names the file", "[io][kitti][bad-input]") {
   }
 }
 
-TEST_CASE("KITTI loader: times.txt must increase strictly; BOM skipped; FIFOs refused, not read", "[io][kitti][bad-input]") {
+TEST_CASE("KITTI loader: times.txt must increase strictly, BOM skipped, FIFOs refused, not read", "[io][kitti][bad-input]") {
   rgbl::test::SyntheticKitti kitti;
   const auto times = kitti.dir / "times.txt";
   // duplicate and decreasing times used to pass, and the TUM trajectory written then was refused by rgbl eval

@@ -166,7 +166,7 @@ TEST_CASE("threaded loop closing: an exception in the loop thread is rethrown to
   system.reset();
 }
 
-TEST_CASE("threaded mapping: a lagging mapper does not thin the map; keyframes stay as few as inline") {
+TEST_CASE("threaded mapping: a lagging mapper does not thin the map, keyframes stay as few as inline") {
   // Frames built beforehand and tracked back to back, so that local mapping lags as it does when a
   // dataset is read from disk on 2 cores. Before: local mapping created each keyframe's depth
   // landmarks, so while it lagged tracking met a thin map, made every frame a keyframe and the queue

@@ -42,7 +42,7 @@ Eigen::Vector3d world_point(const rgbl::SyntheticGenerator& g, int frame, const 
 
 }  // namespace
 
-TEST_CASE("same seed, same bytes; another seed, another street") {
+TEST_CASE("same seed, same bytes, another seed, another street") {
   rgbl::SyntheticOptions o = small_options();
   o.frames = 2;
   const rgbl::SyntheticSequence a = rgbl::generate_sequence(o);
@@ -225,7 +225,7 @@ TEST_CASE("projected noiseless LiDAR agrees with the exact depth image") {
   CHECK(static_cast<double>(close) / projected > 0.8);
 }
 
-TEST_CASE("texture: ORB finds many corners all over the image; the untextured stretch is blank") {
+TEST_CASE("texture: ORB finds many corners all over the image, the untextured stretch is blank") {
   rgbl::SyntheticOptions o;  // default size
   o.frames = 12;
   o.untextured = rgbl::FrameRange{10, 11};

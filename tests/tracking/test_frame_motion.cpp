@@ -67,7 +67,7 @@ double rotation_error_deg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b
 
 }  // namespace
 
-TEST_CASE("frame motion: a van ahead at the camera's speed holds most matches; coverage and the prior keep the scene") {
+TEST_CASE("frame motion: a van ahead at the camera's speed holds most matches, coverage and the prior keep the scene") {
   const rgbl::PinholeCamera cam = rgbl::test::kitti_camera();
   std::mt19937 rng(11);
   // The car drives 1.4 m forward and yaws 0.5 deg; a van 12-16 m ahead moves exactly with it, so its
@@ -127,7 +127,7 @@ TEST_CASE("frame motion: options are validated with their keys") {
   CHECK_THROWS_WITH(options.validate(), Catch::Matchers::Contains("tracker.ransac_min_inliers"));
 }
 
-TEST_CASE("frame motion: a truck alongside at the camera's speed covers more of the image; the road decides") {
+TEST_CASE("frame motion: a truck alongside at the camera's speed covers more of the image, the road decides") {
   const rgbl::PinholeCamera cam = rgbl::test::kitti_camera();
   std::mt19937 rng(5);
   // The camera (1.65 m above the road, y down) drives 1.0 m forward. A truck's side 2.5 m to the right

@@ -63,7 +63,7 @@ TEST_CASE("keypoint grid returns exactly the keypoints inside the window and lev
   }
 }
 
-TEST_CASE("system: configuration errors name the key; no depth keeps it uninitialised") {
+TEST_CASE("system: configuration errors name the key, no depth keeps it uninitialised") {
   auto extractor = [](const cv::Mat&, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
     k.clear();
     d.clear();
