@@ -14,7 +14,9 @@
 #include <cerrno>
 #include <cstring>
 #include <random>
+#include <string_view>
 #include <system_error>
+#include <vector>
 
 namespace rgbl {
 namespace {
@@ -37,6 +39,8 @@ class FileDescriptor {
  private:
   int fd_;
 };
+
+constexpr std::string_view kTemporarySuffix = ".part";
 
 // Creates (O_EXCL) a file named <prefix>.<random><suffix> in `folder` that no one else uses, mode 0666
 // less the umask as for any new file; returns its path, or the errno of the failure.
@@ -82,7 +86,7 @@ void write_through(const fs::path& file, bool fifo, const std::function<void(std
 // A regular file (or a new one): written to a temporary next to it and renamed over it.
 void replace(const fs::path& file, const struct stat* existing, const std::function<void(std::ofstream&)>& write) {
   const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
-  const auto [tmp, error] = create_unique(folder, file.filename().string(), ".part");
+  const auto [tmp, error] = create_unique(folder, file.filename().string(), std::string(kTemporarySuffix));
   if (tmp.empty()) throw Error(fmt::format("{}: cannot open for writing ({})", file.string(), errno_text(error)));
   try {
     // the replacement keeps the permissions of the file it replaces
@@ -133,6 +137,27 @@ void write_atomically(const fs::path& file, const std::function<void(std::ofstre
     return write_through(file, false, write);  // a dangling link: create the file it names
   }
   replace(file, nullptr, write);
+}
+
+void write_atomically(const fs::path& file, std::span<const unsigned char> bytes) {
+  write_atomically(file, [&](std::ofstream& out) {
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  });
+}
+
+void remove_temporaries_of(const fs::path& file) {
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  const std::string prefix = file.filename().string() + ".";
+  std::vector<fs::path> stale;
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() > prefix.size() + kTemporarySuffix.size() && name.starts_with(prefix) &&
+        name.ends_with(kTemporarySuffix)) {
+      stale.push_back(it->path());
+    }
+  }
+  for (const fs::path& path : stale) fs::remove(path, ec);
 }
 
 OutputFolder::OutputFolder(fs::path folder) : path_(std::move(folder)) {

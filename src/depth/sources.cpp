@@ -13,7 +13,6 @@
 #include <charconv>
 #include <system_error>
 #include <cmath>
-#include <fstream>
 #include <limits>
 
 namespace rgbl {
@@ -70,9 +69,7 @@ void write_depth_png(const std::filesystem::path& file, const cv::Mat_<float>& d
   std::vector<unsigned char> png;
   if (!cv::imencode(".png", raw, png)) throw ParseError(file, 0, "a depth map that encodes as PNG");
   // atomically: a reader (a run using --depth precomputed) never sees half a map
-  write_atomically(file, [&](std::ofstream& out) {
-    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-  });
+  write_atomically(file, png);
 }
 
 void sample_dense_depth(const cv::Mat_<float>& dense, const Kernel& kernel, std::span<const Eigen::Vector2f> pixels,

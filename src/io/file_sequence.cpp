@@ -10,7 +10,6 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <fstream>
 #include <utility>
 #include <vector>
 
@@ -154,9 +153,7 @@ void write_png_file(const std::filesystem::path& file, const cv::Mat& image) {
     throw Error(fmt::format("{}: cannot encode a PNG of this image ({}x{}, type {})", file.string(), image.cols,
                             image.rows, image.type()));
   }
-  write_atomically(file, [&](std::ofstream& out) {
-    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-  });
+  write_atomically(file, png);
 }
 
 cv::Mat read_image_file(const std::filesystem::path& file, int flags) {

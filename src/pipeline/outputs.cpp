@@ -10,7 +10,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <cmath>
 #include <system_error>
 #include <unordered_map>
@@ -128,23 +127,12 @@ const std::vector<std::string>& run_output_files() {
 }
 
 void remove_run_outputs(const std::filesystem::path& out_dir) {
-  const auto& names = run_output_files();
-  for (const auto& name : names) {
+  for (const auto& name : run_output_files()) {
     std::error_code ec;
     std::filesystem::remove(out_dir / name, ec);
+    // and what a run killed while writing it left (the caller holds the folder's lock)
+    remove_temporaries_of(out_dir / name);
   }
-  // A run killed while writing (SIGKILL, power loss) leaves write_atomically's <name>.<random>.part;
-  // the caller holds the folder's lock, so no other rgbl process is writing them now.
-  std::vector<std::filesystem::path> stale;
-  std::error_code ec;
-  for (std::filesystem::directory_iterator it(out_dir, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string file = it->path().filename().string();
-    const auto temporary_of = [&](const std::string& name) {
-      return file.size() > name.size() + 6 && file.starts_with(name + ".") && file.ends_with(".part");
-    };
-    if (std::any_of(names.begin(), names.end(), temporary_of)) stale.push_back(it->path());
-  }
-  for (const auto& file : stale) std::filesystem::remove(file, ec);
 }
 
 std::string summary_json(const RunResult& run) {

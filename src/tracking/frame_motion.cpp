@@ -89,6 +89,9 @@ std::vector<bool> ground_keypoints(const PinholeCamera& camera, const Frame& fra
   return ground;
 }
 
+// A rival motion needs no more than a minimal sample's support: the local map judges it (tracker).
+constexpr int kMinRivalInliers = 3;
+
 // Why: breaks the feedback of the constant-velocity prediction on periodic or weak texture (fences,
 // grass), where guided matching around a slightly wrong prediction finds matches that confirm it; the
 // prior keeps a rigid object that moves with the camera (a van ahead at the same speed) from taking
@@ -238,88 +241,81 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
                               options.ransac_prior_relative * prior->translation().norm() &&
            rotation <= options.ransac_prior_rotation_deg * std::numbers::pi / 180.0;
   };
-  std::mt19937 rng(7);  // fixed seed: deterministic
-  std::uniform_int_distribution<int> pick(0, n - 1);
-  std::vector<int> best, best_near, current;
-  Score best_score{-1, -1, 0}, near_score{-1, -1, 0};
-  Eigen::Isometry3d T_best = Eigen::Isometry3d::Identity(), T_near = Eigen::Isometry3d::Identity();
+  // 3-point samples of the matches in `pool`, ransac_iterations of them (fixed seeds: deterministic);
+  // consider(T, consensus, score) sees each sampled motion, best(...) keeps the best-scoring one.
+  std::vector<int> current;
+  auto sample_motions = [&](unsigned seed, const auto& consider) {
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<std::size_t> pick(0, pool.size() - 1);
+    for (int it = 0; it < options.ransac_iterations; ++it) {
+      const std::array<int, 3> sample = {pool[pick(rng)], pool[pick(rng)], pool[pick(rng)]};
+      if (sample[0] == sample[1] || sample[1] == sample[2] || sample[0] == sample[2]) continue;
+      const Eigen::Isometry3d T = fit(sample);
+      inliers_of(T, current);
+      consider(T, score_of(current));
+    }
+  };
+  struct Best {
+    std::vector<int> consensus;
+    Score score{-1, -1, 0};
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  };
+  auto keep_if_better = [&](Best& b, const Eigen::Isometry3d& T, const Score& score) {
+    if (!(score > b.score)) return;
+    b.consensus = current;
+    b.score = score;
+    b.T = T;
+  };
+  Best best, near;
   if (use_prior) {
     // The prior itself, refined, is the first near hypothesis: sampling alone may miss the static
     // scene when a moving object holds most of the matches.
-    T_near = *prior;
-    inliers_of(T_near, best_near);
-    refine(T_near, best_near);
-    if (!near_prior(T_near)) best_near.clear();
-    near_score = score_of(best_near);
+    near.T = *prior;
+    inliers_of(near.T, near.consensus);
+    refine(near.T, near.consensus);
+    if (!near_prior(near.T)) near.consensus.clear();
+    near.score = score_of(near.consensus);
   }
-  for (int it = 0; it < options.ransac_iterations; ++it) {
-    const std::array<int, 3> sample = {pick(rng), pick(rng), pick(rng)};
-    if (sample[0] == sample[1] || sample[1] == sample[2] || sample[0] == sample[2]) continue;
-    const Eigen::Isometry3d T = fit(sample);
-    inliers_of(T, current);
-    const auto score = score_of(current);
-    if (use_prior && score > near_score && near_prior(T)) {
-      best_near = current;
-      near_score = score;
-      T_near = T;
-    }
-    if (score > best_score) {
-      best.swap(current);
-      best_score = score;
-      T_best = T;
-    }
-  }
+  sample_motions(7, [&](const Eigen::Isometry3d& T, const Score& score) {
+    if (use_prior && near_prior(T)) keep_if_better(near, T, score);
+    keep_if_better(best, T, score);
+  });
   if (use_prior) {
     // The constant-velocity prior is trusted: refine it with the near consensus, or keep it as is;
     // never jump to a far motion (a real jump in the input is caught later, by the verification).
-    if (best_near.empty()) return std::nullopt;
-    refine(T_near, best_near);
-    if (!near_prior(T_near) || static_cast<int>(best_near.size()) < options.ransac_min_inliers) return std::nullopt;
-    if (moving != nullptr) label_moving(T_near, moving);
-    if (!best.empty() && best.size() > best_near.size() && !near_prior(T_best)) {
+    if (near.consensus.empty()) return std::nullopt;
+    refine(near.T, near.consensus);
+    if (!near_prior(near.T) || static_cast<int>(near.consensus.size()) < options.ransac_min_inliers) return std::nullopt;
+    if (moving != nullptr) label_moving(near.T, moving);
+    if (!best.consensus.empty() && best.consensus.size() > near.consensus.size() && !near_prior(best.T)) {
       logger()->debug("frame {}: depth RANSAC keeps the motion near constant velocity ({} inliers) over another "
-                      "({} inliers, {:.2f} m from it)", frame.index, best_near.size(), best.size(),
-                      (T_best.translation() - prior->translation()).norm());
+                      "({} inliers, {:.2f} m from it)", frame.index, near.consensus.size(), best.consensus.size(),
+                      (best.T.translation() - prior->translation()).norm());
     }
-    return T_near;
+    return near.T;
   }
-  refine(T_best, best);
-  if (static_cast<int>(best.size()) < options.ransac_min_inliers) return std::nullopt;
-  if (moving != nullptr) label_moving(T_best, moving);
+  refine(best.T, best.consensus);
+  if (static_cast<int>(best.consensus.size()) < options.ransac_min_inliers) return std::nullopt;
+  if (moving != nullptr) label_moving(best.T, moving);
   if (rival != nullptr) {
-    // The same RANSAC on the matches the winner leaves out (its own seed, so the winner is unchanged).
+    // The same sampling on the matches the winner leaves out (its own seed, so the winner is unchanged).
     std::vector<int> rest;
-    std::set_difference(all.begin(), all.end(), best.begin(), best.end(), std::back_inserter(rest));
-    if (static_cast<int>(rest.size()) >= 3) {
+    std::set_difference(all.begin(), all.end(), best.consensus.begin(), best.consensus.end(), std::back_inserter(rest));
+    if (static_cast<int>(rest.size()) >= kMinRivalInliers) {
       pool = rest;
-      std::uniform_int_distribution<std::size_t> pick_rest(0, rest.size() - 1);
-      std::mt19937 rng_rest(13);
-      std::vector<int> second;
-      Score second_score{-1, -1, 0};
-      Eigen::Isometry3d T_second = Eigen::Isometry3d::Identity();
-      for (int it = 0; it < options.ransac_iterations; ++it) {
-        const std::array<int, 3> sample = {rest[pick_rest(rng_rest)], rest[pick_rest(rng_rest)], rest[pick_rest(rng_rest)]};
-        if (sample[0] == sample[1] || sample[1] == sample[2] || sample[0] == sample[2]) continue;
-        const Eigen::Isometry3d T = fit(sample);
-        inliers_of(T, current);
-        const auto score = score_of(current);
-        if (score > second_score) {
-          second.swap(current);
-          second_score = score;
-          T_second = T;
-        }
-      }
-      refine(T_second, second);
-      if (static_cast<int>(second.size()) >= 3) {
+      Best second;
+      sample_motions(13, [&](const Eigen::Isometry3d& T, const Score& score) { keep_if_better(second, T, score); });
+      refine(second.T, second.consensus);
+      if (static_cast<int>(second.consensus.size()) >= kMinRivalInliers) {
         RivalMotion r;
-        r.T_cur_last = T_second;
-        r.inliers = second.size();
-        if (moving != nullptr) label_moving(T_second, &r.moving);
+        r.T_cur_last = second.T;
+        r.inliers = second.consensus.size();
+        if (moving != nullptr) label_moving(second.T, &r.moving);
         *rival = std::move(r);
       }
     }
   }
-  return T_best;
+  return best.T;
 }
 
 }  // namespace rgbl

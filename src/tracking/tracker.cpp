@@ -186,10 +186,10 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
       ViewLog rival_views;
       ViewLog& other_views = other_start.rival ? rival_views : views;
       const LocalMapResult other = track_local_map(other_start.frame, reference, h.relocalisation_frame, other_views);
+      const int road = on_road(frame), other_road = on_road(other_start.frame);
       logger()->debug("frame {}: against the reference keyframe, the local map finds {} of {} points ({} on the road) "
                       "from the first start, {} of {} ({} on the road) from the {} ({:.2f} m apart)", frame.index,
-                      first.local.inliers, first.local.visible, on_road(frame), other.inliers, other.visible,
-                      on_road(other_start.frame),
+                      first.local.inliers, first.local.visible, road, other.inliers, other.visible, other_road,
                       other_start.rival ? "second rigid motion in view" : "weak depth consensus",
                       (frame.T_cam_world.inverse().translation() - other_start.frame.T_cam_world.inverse().translation()).norm());
       // Poses further apart than a vehicle's step tolerance are evidence that contradicts itself,
@@ -199,7 +199,7 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
       if (apart && !other_start.rival) h.weak = true;
       // A rival within a step's tolerance of the first start is the same motion found twice.
       const bool better = (apart || !other_start.rival) &&
-                          std::pair(on_road(other_start.frame), other.inliers) > std::pair(on_road(frame), first.local.inliers);
+                          std::pair(other_road, other.inliers) > std::pair(road, first.local.inliers);
       if (better) {
         frame = std::move(other_start.frame);
         first.local = other;

@@ -11,6 +11,7 @@
 #include <sys/sysmacros.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -66,6 +67,22 @@ TEST_CASE("write_atomically leaves no temporary file when the writer throws") {
                   std::runtime_error);
   CHECK(contents(file) == "old");
   CHECK(names_in(dir.path()) == std::vector<std::string>{"report.json"});
+}
+
+TEST_CASE("write_atomically writes bytes, and a killed writer's temporaries are removed, nothing else") {
+  const rgbl::TemporaryFolder dir;
+  const auto file = dir.path() / "map.png";
+  const std::vector<unsigned char> bytes = {0x89, 'P', 'N', 'G', 0x00, 0xff};
+  rgbl::write_atomically(file, bytes);
+  CHECK(contents(file) == std::string(bytes.begin(), bytes.end()));
+  // what SIGKILL during a write leaves, next to look-alikes that are not this file's temporaries
+  for (const char* name : {"map.png.1a2b3c4d.part", "map.png.part", "other.png.1a2b3c4d.part", "notes.part"}) {
+    std::ofstream(dir.path() / name) << "x";
+  }
+  rgbl::remove_temporaries_of(file);
+  auto names = names_in(dir.path());
+  std::sort(names.begin(), names.end());
+  CHECK(names == std::vector<std::string>{"map.png", "map.png.part", "notes.part", "other.png.1a2b3c4d.part"});
 }
 
 TEST_CASE("write_atomically writes through a symbolic link, keeping the link") {

@@ -27,11 +27,7 @@ Mapped track_frames(const CameraCalibration& calibration, std::size_t count, Loa
   m.calibration = calibration;
   DepthSourceContext depth;
   depth.calibration = m.calibration;
-  auto orb = std::make_shared<OrbExtractor>();
-  m.system = std::make_unique<System>(options, m.calibration, make_lidar_source({}, depth),
-                                      [orb](const cv::Mat& gray, std::vector<Keypoint>& kps, std::vector<Descriptor>& desc) {
-                                        orb->extract(gray, kps, desc);
-                                      });
+  m.system = std::make_unique<System>(options, m.calibration, make_lidar_source({}, depth), make_orb_extractor({}));
   for (std::size_t i = 0; i < count; ++i) {
     const FrameInput& input = load(i);  // a temporary lives until the end of this iteration
     SensorFrame frame = sensor_frame(input);

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -22,6 +23,12 @@ namespace rgbl {
 //  - a folder: an error.
 // On failure (including an exception from `write`) removes the temporary and throws Error naming `file`.
 void write_atomically(const std::filesystem::path& file, const std::function<void(std::ofstream&)>& write);
+// The same with the bytes to write (e.g. an encoded image).
+void write_atomically(const std::filesystem::path& file, std::span<const unsigned char> bytes);
+
+// Removes the temporaries write_atomically leaves for `file` when its process is killed while writing
+// (<name>.<random>.part next to it). Only for a folder no other process writes into (OutputFolder).
+void remove_temporaries_of(const std::filesystem::path& file);
 
 // A folder this process writes a set of outputs into: created when missing, checked to be writable
 // (so that a run finds an unusable folder before it works, not after), and locked against other
