@@ -69,44 +69,13 @@ int run_info(const InfoArgs& args) {
   for (const auto& note : seq.notes()) fmt::print("note:          {}\n", note);
 
   if (args.check) {
-    // every file of every frame, one sensor at a time, so that all the bad files are listed, not the first
-    std::vector<LoadOptions> sensor_loads;
-    LoadOptions none;
-    none.cameras = {false, false, false, false};
-    none.lidar = false;
-    none.depth = false;
-    for (std::size_t c = 0; c < 4; ++c) {
-      if (!sensors.cameras[c]) continue;
-      sensor_loads.push_back(none);
-      sensor_loads.back().cameras[c] = true;
-    }
-    if (sensors.lidar) {
-      sensor_loads.push_back(none);
-      sensor_loads.back().lidar = true;
-    }
-    if (sensors.depth) {
-      sensor_loads.push_back(none);
-      sensor_loads.back().depth = true;
-    }
-    std::size_t bad_files = 0, bad_frames = 0;
-    std::string first_problem;
-    for (std::size_t i = 0; i < seq.size(); ++i) {
-      bool bad = false;
-      for (const LoadOptions& load : sensor_loads) {
-        try {
-          (void)seq.load(i, load);
-        } catch (const Error& e) {
-          fmt::print("check:         frame {}: {}\n", i, e.what());
-          if (first_problem.empty()) first_problem = e.what();
-          ++bad_files;
-          bad = true;
-        }
-      }
-      bad_frames += bad ? 1 : 0;
-    }
-    if (bad_files > 0) {
+    const std::vector<LoadProblem> problems = check_sequence(seq);
+    for (const LoadProblem& p : problems) fmt::print("check:         frame {}: {}\n", p.frame, p.message);
+    if (!problems.empty()) {
+      std::size_t bad_frames = 0;  // problems come in frame order
+      for (std::size_t k = 0; k < problems.size(); ++k) bad_frames += (k == 0 || problems[k].frame != problems[k - 1].frame) ? 1 : 0;
       throw Error(fmt::format("{}: {} file(s) of {} of the {} frames do not load (listed above), the first: {}",
-                              seq.path().string(), bad_files, bad_frames, seq.size(), first_problem));
+                              seq.path().string(), problems.size(), bad_frames, seq.size(), problems.front().message));
     }
     fmt::print("check:         all {} frames load\n", seq.size());
   }

@@ -471,4 +471,39 @@ std::unique_ptr<Sequence> open_sequence(const fs::path& dir, DatasetFormat forma
   throw ConfigError("format", "one of auto, kitti, kitti-raw, tum");
 }
 
+std::vector<LoadProblem> check_sequence(const Sequence& sequence,
+                                        const std::function<void(std::size_t, std::size_t)>& progress) {
+  const SensorSet& sensors = sequence.sensors();
+  LoadOptions none;
+  none.cameras = {false, false, false, false};
+  none.lidar = false;
+  none.depth = false;
+  std::vector<LoadOptions> loads;  // one sensor each
+  for (std::size_t c = 0; c < sensors.cameras.size(); ++c) {
+    if (!sensors.cameras[c]) continue;
+    loads.push_back(none);
+    loads.back().cameras[c] = true;
+  }
+  if (sensors.lidar) {
+    loads.push_back(none);
+    loads.back().lidar = true;
+  }
+  if (sensors.depth) {
+    loads.push_back(none);
+    loads.back().depth = true;
+  }
+  std::vector<LoadProblem> problems;
+  for (std::size_t i = 0; i < sequence.size(); ++i) {
+    for (const LoadOptions& load : loads) {
+      try {
+        (void)sequence.load(i, load);
+      } catch (const Error& e) {
+        problems.push_back({i, e.what()});
+      }
+    }
+    if (progress) progress(i + 1, sequence.size());
+  }
+  return problems;
+}
+
 }  // namespace rgbl

@@ -8,7 +8,9 @@
 
 #include <cmath>
 #include <fstream>
+#include <filesystem>
 #include <limits>
+#include <vector>
 #include <sys/stat.h>
 
 using Catch::Matchers::Contains;
@@ -91,6 +93,30 @@ TEST_CASE("synthetic KITTI sequence loads every sensor", "[io][kitti]") {
   CHECK(f.scan[1].intensity == 0.25F);
   CHECK(f.T_world_cam0->translation().z() == 2.0);
   CHECK_THROWS_WITH(seq->load(3), Contains("frame 3 requested, the sequence has 3"));
+}
+
+TEST_CASE("check_sequence lists every file that does not load, sensor by sensor", "[io][kitti][bad-input]") {
+  rgbl::test::SyntheticKitti kitti(4, 4);
+  const auto seq = rgbl::open_kitti_odometry(kitti.dir);
+  std::vector<std::size_t> progress;
+  CHECK(rgbl::check_sequence(*seq, [&](std::size_t done, std::size_t total) {
+          CHECK(total == 4);
+          progress.push_back(done);
+        }).empty());
+  CHECK(progress == std::vector<std::size_t>{1, 2, 3, 4});
+
+  // frame 1: both its image and its scan are bad, and both are listed; frame 3: the colour image only
+  std::ofstream(kitti.image0(1)) << "not a PNG";
+  std::ofstream(kitti.scan(1)) << "twenty bytes of junk";
+  std::filesystem::remove(kitti.dir / "image_2" / "000003.png");
+  const std::vector<rgbl::LoadProblem> problems = rgbl::check_sequence(*seq);
+  REQUIRE(problems.size() == 3);
+  CHECK(problems[0].frame == 1);
+  CHECK_THAT(problems[0].message, Contains("image_0/000001.png"));
+  CHECK(problems[1].frame == 1);
+  CHECK_THAT(problems[1].message, Contains("velodyne/000001.bin"));
+  CHECK(problems[2].frame == 3);
+  CHECK_THAT(problems[2].message, Contains("image_2/000003.png"));
 }
 
 TEST_CASE("KITTI loader: bad input names the file", "[io][kitti][bad-input]") {

@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -101,5 +102,16 @@ std::unique_ptr<Sequence> open_tum_rgbd(const std::filesystem::path& dir, const 
 std::unique_ptr<Sequence> open_sequence(const std::filesystem::path& dir,
                                         DatasetFormat format = DatasetFormat::automatic,
                                         const LoadOptions& options = {});
+
+// A file of a sequence that does not load: the frame and the loader's message (which names the file).
+struct LoadProblem {
+  std::size_t frame = 0;
+  std::string message;
+};
+
+// Loads every file of every frame, one sensor at a time, so that every bad file is listed, not only
+// the first of a frame. `progress(done, total)` is called after each frame when given.
+std::vector<LoadProblem> check_sequence(const Sequence& sequence,
+                                        const std::function<void(std::size_t, std::size_t)>& progress = {});
 
 }  // namespace rgbl
