@@ -10,8 +10,8 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/file.hpp"
 #include "rgbl/core/timer.hpp"
+#include "rgbl/pipeline/demo.hpp"
 #include "rgbl/sim/scenarios.hpp"
-#include "rgbl/sim/synthetic.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -30,16 +30,9 @@ namespace {
 namespace fs = std::filesystem;
 
 struct DemoArgs {
-  int frames = 0;  // 0: 60 (a bend of the curve), 80 per lap of a loop (the shortest that closes), a scenario's own
-  std::string path = "curve";
-  std::string scenario;  // empty: the street of --path
-  std::uint64_t seed = 1;
-  std::string depth = "lidar";
+  DemoOptions demo;
   std::string out = "rgbl_demo_output";
   std::string keep;  // dataset folder to keep; empty = a temporary folder, removed afterwards
-  bool threaded = false;
-  int laps = 1;  // of --path loop
-  bool no_loop_closing = false;
 };
 
 void print_scenarios() {
@@ -49,37 +42,17 @@ void print_scenarios() {
 }
 
 int run_demo(const DemoArgs& args, bool quiet) {
-  if (args.scenario == "list") {
+  if (args.demo.scenario == "list") {
     print_scenarios();
     return 0;
   }
+  const DemoOptions& demo = args.demo;
   SyntheticOptions sim;
-  if (!args.scenario.empty()) {
-    sim = scenario_options(args.scenario, args.seed, args.frames);  // throws naming "scenario"
-  } else {
-    sim.frames = args.frames > 0 ? args.frames : (args.path == "loop" ? 80 * args.laps : 60);
-    sim.seed = args.seed;
-    sim.path.kind = *parse_path_kind(args.path);  // CLI11 checked the name
+  try {
+    sim = demo_simulation(demo);
+  } catch (const ConfigError& e) {
+    throw ConfigError("--" + e.key(), e.expected());  // DemoOptions' keys are the options' names
   }
-  sim.depth_camera = 0;  // the exact depth of the camera `run` tracks by default
-  if (args.laps != 1 && sim.path.kind != PathKind::loop) {
-    throw ConfigError("--laps", "--path loop (the other paths and the scenarios do not come back)");
-  }
-  if (sim.path.kind == PathKind::loop) fit_loop(sim, args.laps);
-
-  // refuse what cannot work before spending the generation time on it (the layout has no depth camera)
-  const DepthSourceNeeds needs = builtin_depth_sources().entry(args.depth).needs;
-  if (needs.depth_image) {
-    throw ConfigError("--depth", fmt::format("lidar[:...], stereo or precomputed[:<dir>] for the demo's KITTI layout "
-                                             "(it has no depth-camera images; `precomputed` reads the exact depth), "
-                                             "not '{}'",
-                                             args.depth));
-  }
-  // render only what tracking camera 0 with this depth source reads: the right image for stereo, the
-  // exact depth for `precomputed` alone; the scan is always written (the KITTI layout's velodyne/)
-  sim.cameras = {true, needs.right_image, false, false};
-  sim.render_depth = args.depth == "precomputed";
-  sim.validate();
 
   std::optional<TemporaryFolder> temp;
   fs::path root;
@@ -118,19 +91,11 @@ int run_demo(const DemoArgs& args, bool quiet) {
   if (!quiet && tty) fmt::print(stderr, "\n");
   const double generation_s = generation.elapsed_ms() / 1000.0;
   fmt::print("synthetic street: {} frames of {} ({}x{}, seed {}, {:.0f} m) generated in {:.1f} s ({:.0f} ms per frame)\n",
-             sim.frames, args.scenario.empty() ? fmt::format("a {} path", args.path) : "scenario " + args.scenario,
+             sim.frames, demo.scenario.empty() ? fmt::format("a {} path", demo.path) : "scenario " + demo.scenario,
              sim.width, sim.height, sim.seed, sim.driven_length(), generation_s, 1000.0 * generation_s / sim.frames);
   std::fflush(stdout);  // before the run's progress on stderr
 
-  PipelineOptions input;
-  input.dataset = layout.sequence_dir;
-  input.format = DatasetFormat::kitti;
-  input.depth = args.depth;
-  // `precomputed` alone: the exact depth images the generator wrote next to the images
-  if (input.depth == "precomputed") input.depth = "precomputed:" + (layout.sequence_dir / "depth").string();
-  input.threaded = args.threaded;
-  input.loop_closing = !args.no_loop_closing;
-  const RunResult run = run_and_report(Pipeline(input), out, quiet, interrupt);
+  const RunResult run = run_and_report(Pipeline(demo_pipeline(demo, layout)), out, quiet, interrupt);
 
   if (temp) {
     fmt::print("  the generated dataset was removed (keep it with --keep <dir>)\n");
@@ -149,17 +114,17 @@ Command add_demo_command(CLI::App& parent) {
   auto* app = parent.add_subcommand(
       "demo", "Generate a synthetic street with exact ground truth and track it like `rgbl run` (no dataset needed)");
   auto args = std::make_shared<DemoArgs>();
-  app->add_option("--frames", args->frames, "Frames to generate and track (default: 60; 80 per lap of a loop, which needs >= 77 per lap; a "
+  app->add_option("--frames", args->demo.frames, "Frames to generate and track (default: 60; 80 per lap of a loop, which needs >= 77 per lap; a "
                                    "scenario's own)")
       ->check(CLI::Range(2, 100000));
-  auto* path = app->add_option("--path", args->path, "Camera path")
+  auto* path = app->add_option("--path", args->demo.path, "Camera path")
                    ->check(CLI::IsMember({"straight", "curve", "loop"}))
                    ->capture_default_str();
-  app->add_option("--scenario", args->scenario,
+  app->add_option("--scenario", args->demo.scenario,
                   "A stress scenario instead of --path (`--scenario list` prints them; `plain` is the reference)")
       ->excludes(path);
-  app->add_option("--seed", args->seed, "Seed of the scene and all noise")->capture_default_str();
-  app->add_option("--depth", args->depth,
+  app->add_option("--seed", args->demo.seed, "Seed of the scene and all noise")->capture_default_str();
+  app->add_option("--depth", args->demo.depth,
                   "Depth source as for `rgbl run`: lidar (5x5 diamond), lidar:ipbasic, lidar:diamond7, stereo, "
                   "precomputed (the exact depth images) or precomputed:<dir>")
       ->capture_default_str();
@@ -167,11 +132,11 @@ Command add_demo_command(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--keep", args->keep, "Write the synthetic dataset to this new or empty folder and keep it "
                                         "(default: a temporary folder, removed afterwards)");
-  app->add_option("--laps", args->laps, "Laps of --path loop in the frames driven (2: past the start and round again)")
+  app->add_option("--laps", args->demo.laps, "Laps of --path loop in the frames driven (2: past the start and round again)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
-  app->add_flag("--threaded", args->threaded, "Local mapping and loop closing in threads of their own");
-  app->add_flag("--no-loop-closing", args->no_loop_closing, "Track without loop closing (to compare)");
+  app->add_flag("--threaded", args->demo.threaded, "Local mapping and loop closing in threads of their own");
+  app->add_flag_callback("--no-loop-closing", [args] { args->demo.loop_closing = false; }, "Track without loop closing (to compare)");
   return {app, [args, app] {
             const bool quiet = app->get_parent()->get_option("--quiet")->as<bool>();
             return run_demo(*args, quiet);

@@ -16,6 +16,6 @@ ParseError::ParseError(std::filesystem::path file, std::size_t line, const std::
     : Error(parse_message(file, line, expected)), file_(std::move(file)), line_(line) {}
 
 ConfigError::ConfigError(std::string key, const std::string& expected)
-    : Error(fmt::format("invalid option '{}': expected {}", key, expected)), key_(std::move(key)) {}
+    : Error(fmt::format("invalid option '{}': expected {}", key, expected)), key_(std::move(key)), expected_(expected) {}
 
 }  // namespace rgbl

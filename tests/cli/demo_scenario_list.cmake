@@ -20,7 +20,7 @@ if(out MATCHES "generated|ATE")
 endif()
 
 execute_process(COMMAND ${RGBL} demo --scenario no-such-street RESULT_VARIABLE rc ERROR_VARIABLE err)
-if(rc EQUAL 0 OR NOT err MATCHES "^error: invalid option 'scenario'.*lead-vehicle")
+if(rc EQUAL 0 OR NOT err MATCHES "^error: invalid option '--scenario'.*lead-vehicle")
   message(FATAL_ERROR "an unknown scenario: expected an error naming the option and the known names, got exit ${rc}: ${err}")
 endif()
 execute_process(COMMAND ${RGBL} demo --scenario plain --path loop RESULT_VARIABLE rc ERROR_VARIABLE err)

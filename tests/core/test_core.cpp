@@ -27,6 +27,9 @@ TEST_CASE("ConfigError names the key") {
   CHECK_THROWS_WITH(rgbl::require(false, "projection.max_depth", "a depth > 0"),
                     "invalid option 'projection.max_depth': expected a depth > 0");
   CHECK_NOTHROW(rgbl::require(true, "k", "x"));
+  const rgbl::ConfigError e("frames", ">= 1");
+  CHECK(e.key() == "frames");
+  CHECK(e.expected() == ">= 1");  // an application can re-key it with its own option name
 }
 
 TEST_CASE("library logger can be redirected by the application") {

@@ -1,6 +1,7 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/file.hpp"
 #include "rgbl/core/task_pool.hpp"
+#include "rgbl/pipeline/demo.hpp"
 #include "rgbl/pipeline/pipeline.hpp"
 #include "rgbl/sim/sim_sequence.hpp"
 #include "rgbl/sim/synthetic.hpp"
@@ -227,6 +228,71 @@ TEST_CASE("the simulator as an in-memory sequence: loaded frames equal the rende
   CHECK(run.metrics->evaluation.ate.translation.rmse < 0.1);
   CHECK(run.frames.back().result.map_keyframes == run.keyframes.size());
   CHECK(run.frames.back().result.map_landmarks == run.landmarks.size());
+}
+
+TEST_CASE("the demo as a library: a scenario or a path, only the sensors its depth source reads, tracked end to end") {
+  using Catch::Matchers::Contains;
+  rgbl::DemoOptions demo;
+  demo.scenario = "lead-vehicle";
+  demo.seed = 3;
+  demo.frames = 12;
+  const rgbl::SyntheticOptions scenario = rgbl::demo_simulation(demo);
+  CHECK(scenario.frames == 12);
+  CHECK(scenario.seed == 3);
+  CHECK(scenario.cameras == std::array<bool, 4>{true, false, false, false});  // LiDAR depth: camera 0 alone
+  CHECK_FALSE(scenario.render_depth);
+
+  rgbl::DemoOptions loop;
+  loop.path = "loop";
+  loop.laps = 2;
+  loop.depth = "stereo";
+  const rgbl::SyntheticOptions two_laps = rgbl::demo_simulation(loop);
+  CHECK(two_laps.frames == 160);  // 80 per lap by default
+  CHECK(two_laps.path.kind == rgbl::PathKind::loop);
+  CHECK(two_laps.cameras == std::array<bool, 4>{true, true, false, false});  // stereo reads the right image
+
+  // every refusal names the key, before anything is generated
+  const auto refused = [](rgbl::DemoOptions o, const char* key) {
+    try {
+      (void)rgbl::demo_simulation(o);
+      FAIL("accepted, expected a refusal naming " << key);
+    } catch (const rgbl::ConfigError& e) {
+      CHECK(e.key() == key);
+    }
+  };
+  rgbl::DemoOptions bad;
+  bad.path = "spiral";
+  refused(bad, "path");
+  bad = {};
+  bad.laps = 2;  // the curve does not come back
+  refused(bad, "laps");
+  bad = {};
+  bad.depth = "rgbd";  // the KITTI layout has no depth camera
+  refused(bad, "depth");
+  bad = {};
+  bad.scenario = "nope";
+  refused(bad, "scenario");
+  bad = {};
+  bad.frames = -1;
+  refused(bad, "frames");
+
+  // `precomputed` alone tracks with the exact depth images the generator writes
+  rgbl::test::TempDir dir;
+  rgbl::DemoOptions exact;
+  exact.path = "straight";
+  exact.frames = 12;
+  exact.depth = "precomputed";
+  exact.loop_closing = false;
+  const rgbl::SyntheticOptions sim = rgbl::demo_simulation(exact);
+  CHECK(sim.render_depth);
+  const rgbl::KittiLayout layout = rgbl::write_kitti(rgbl::SyntheticGenerator(sim), dir.path(), 0);
+  const rgbl::PipelineOptions options = rgbl::demo_pipeline(exact, layout);
+  CHECK(options.depth == "precomputed:" + (layout.sequence_dir / "depth").string());
+  CHECK_FALSE(options.loop_closing);
+  const rgbl::RunResult run = rgbl::Pipeline(options).run();
+  CHECK(run.count(rgbl::TrackState::Ok) == 12);
+  REQUIRE(run.metrics);
+  CHECK(run.metrics->evaluation.ate.translation.rmse < 0.05);
 }
 
 TEST_CASE("a pipeline refuses bad options and data it cannot use before the first frame, naming them") {

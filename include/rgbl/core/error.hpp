@@ -35,9 +35,11 @@ class ConfigError : public Error {
   ConfigError(std::string key, const std::string& expected);
 
   const std::string& key() const noexcept { return key_; }
+  const std::string& expected() const noexcept { return expected_; }
 
  private:
   std::string key_;
+  std::string expected_;
 };
 
 // Throws ConfigError(key, expected) unless condition holds: the one-liner for options' validate().
