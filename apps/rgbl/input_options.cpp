@@ -118,17 +118,9 @@ RunResult run_and_report(const Pipeline& pipeline, const OutputFolder& out_dir, 
     fmt::print(stderr, "interrupted by {} after {} of {} frames: writing the partial outputs (summary.json: "
                "\"partial\": true)\n", interrupt.signal_name(), run.frames.size(), run.frames_planned);
   }
-  write_run_outputs(run, out_dir);
-  // A trajectory of guesses is no result: a failed run, whose trajectory files must not exist (as after
-  // any failure); timing.csv and summary.json stay to tell why.
-  const bool failed = !run.stopped && !run.frames.empty() && run.tracked_count() == 0;
-  if (failed) {
-    for (const char* name : {"trajectory_kitti.txt", "trajectory_tum.txt", "trajectory.svg", "map.ply"}) {
-      std::filesystem::remove(out_dir.path() / name);
-    }
-  }
-  print_summary(run, out_dir.path(), failed);
-  if (failed) {
+  write_run_outputs(run, out_dir);  // a failed run: timing.csv and summary.json alone, to tell why
+  print_summary(run, out_dir.path(), run.failed());
+  if (run.failed()) {
     throw Error(fmt::format("no frame of {} was tracked ({} not initialised, {} lost); the reasons are printed "
                             "with -v, per-frame states in {}",
                             run.frames.size(), run.count(TrackState::NotInitialised), run.count(TrackState::Lost),

@@ -193,13 +193,14 @@ void write_run_outputs(const RunResult& run, const std::filesystem::path& out_di
 
 void write_run_outputs(const RunResult& run, const OutputFolder& folder) {
   const std::filesystem::path& out_dir = folder.path();
+  write_text(out_dir / "timing.csv", timing_csv(run));
+  write_text(out_dir / "summary.json", summary_json(run));
+  if (run.failed()) return;  // a trajectory of guesses would look like a result
   write_kitti_trajectory(out_dir / "trajectory_kitti.txt", run.trajectory.poses);
   write_tum_trajectory(out_dir / "trajectory_tum.txt", run.trajectory);
   // the ground truth of the frames run, row for row with trajectory_kitti.txt (for evo and plots; a
   // raw drive's comes from OXTS and has no file of its own)
   if (!run.ground_truth.empty()) write_kitti_trajectory(out_dir / "ground_truth_kitti.txt", run.ground_truth);
-  write_text(out_dir / "timing.csv", timing_csv(run));
-  write_text(out_dir / "summary.json", summary_json(run));
   write_plot(run, out_dir / "trajectory.svg");
   write_ply(out_dir / "map.ply", run.landmarks, {}, run.keyframes);
 }

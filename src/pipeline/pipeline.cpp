@@ -367,6 +367,8 @@ std::size_t RunResult::tracked_count() const {
       std::count_if(frames.begin(), frames.end(), [](const FrameRecord& r) { return has_pose(r.result.state); }));
 }
 
+bool RunResult::failed() const { return !stopped && !frames.empty() && tracked_count() == 0; }
+
 std::size_t RunResult::keyframe_count() const {
   return static_cast<std::size_t>(
       std::count_if(frames.begin(), frames.end(), [](const FrameRecord& r) { return r.result.keyframe; }));

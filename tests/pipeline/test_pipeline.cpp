@@ -126,6 +126,15 @@ TEST_CASE("a run that tracks nothing says so in its metrics: no figure for track
   // the all-frames figure is that of the guesses: the start pose held (5 frames of 1 m)
   CHECK(run.metrics->evaluation.path_length == Approx(5.0).margin(0.5));
   CHECK(run.metrics->evaluation.drift.percent == Approx(100.0));
+  // a trajectory of guesses is no result: the outputs say why, and hold no trajectory
+  CHECK(run.failed());
+  rgbl::write_run_outputs(run, dir.path() / "out");
+  CHECK(std::filesystem::exists(dir.path() / "out" / "summary.json"));
+  CHECK(std::filesystem::exists(dir.path() / "out" / "timing.csv"));
+  for (const char* name : {"trajectory_kitti.txt", "trajectory_tum.txt", "ground_truth_kitti.txt", "trajectory.svg",
+                           "map.ply"}) {
+    CHECK_FALSE(std::filesystem::exists(dir.path() / "out" / name));
+  }
 }
 
 namespace {

@@ -110,6 +110,9 @@ struct RunResult {
 
   std::size_t count(TrackState state) const;
   std::size_t tracked_count() const;  // frames with a tracked pose (ok or weak)
+  // A whole run that tracked no frame: its trajectory is guesses, no result (write_run_outputs writes
+  // no trajectory for it). A stopped run is partial, not failed.
+  bool failed() const;
   std::size_t keyframe_count() const;
   std::optional<int> min_inliers_ok() const;  // fewest local-map inliers on a frame reported ok
   RunTimings timings() const;
@@ -203,7 +206,8 @@ void remove_run_outputs(const std::filesystem::path& out_dir);
 // with trajectory_kitti.txt), timing.csv (a row per frame, a column per stage), summary.json,
 // trajectory.svg (with the ground truth and the loop closures) and map.ply (landmarks and keyframes).
 // Each file is written whole and renamed into place (write_atomically). A stopped run's summary.json
-// says "partial": true.
+// says "partial": true. A failed() run gets timing.csv and summary.json alone, which say why; an
+// earlier run's trajectory files must be gone first (remove_run_outputs).
 void write_run_outputs(const RunResult& result, const std::filesystem::path& out_dir);
 // The same into a folder the caller holds (taken before the run, so that an unusable or busy folder is
 // found before tracking).
