@@ -21,12 +21,17 @@
 
 namespace {
 
-// Last resort for an exception no handler can catch (one escaping a thread, or thrown while another
-// unwinds): the same one `error:` line and exit 1 as main's handlers, not an abort signal.
-[[noreturn]] void report_uncaught() {
+// Prints the exception in flight as one "error: ..." line; returns its exit code.
+int print_error(const std::exception_ptr& error) {
   try {
-    if (const auto error = std::current_exception()) std::rethrow_exception(error);
-    std::fputs("error: internal failure (std::terminate)\n", stderr);
+    if (!error) {
+      std::fputs("error: internal failure (std::terminate)\n", stderr);
+      return 1;
+    }
+    std::rethrow_exception(error);
+  } catch (const rgbl::cli::Interrupted& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return e.exit_code();
   } catch (const cv::Exception& e) {
     fmt::print(stderr, "error: OpenCV failed in {}: {} (an input rgbl does not check yet; please report it)\n",
                e.func, e.err);
@@ -35,11 +40,13 @@ namespace {
   } catch (...) {
     std::fputs("error: unknown failure\n", stderr);
   }
-  std::_Exit(1);
+  return 1;
 }
 
-// Everything printed to stdout must have arrived: a full disk or a closed pipe is a failure, not a
-// success with a truncated report. Returns the exit code.
+// Last resort for an exception no handler can catch (one escaping a thread, or thrown while another
+// unwinds): the same one `error:` line and exit 1 as main's handlers, not an abort signal.
+[[noreturn]] void report_uncaught() { std::_Exit(print_error(std::current_exception())); }
+
 int check_stdout(int code) {
   errno = 0;
   const bool flushed = std::fflush(stdout) == 0;
@@ -87,20 +94,8 @@ int run(int argc, char** argv) {
     }
     std::fputs("error: no command given (see rgbl --help)\n", stderr);
     return 2;
-  } catch (const rgbl::cli::Interrupted& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
-    return e.exit_code();
-  } catch (const cv::Exception& e) {
-    // an input rgbl's checks missed: say so in one line rather than OpenCV's multi-part message
-    fmt::print(stderr, "error: OpenCV failed in {}: {} (an input rgbl does not check yet; please report it)\n",
-               e.func, e.err);
-    return 1;
-  } catch (const std::exception& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
-    return 1;
   } catch (...) {
-    std::fputs("error: unknown failure\n", stderr);
-    return 1;
+    return print_error(std::current_exception());
   }
 }
 
