@@ -199,6 +199,8 @@ SensorFrame Pipeline::sensor_frame(const FrameInput& input) const {
 }
 
 std::unique_ptr<System> Pipeline::make_system() const {
+  // with frame threads every frame is built by a FrameBuilder of run()'s, none by the System
+  if (threads_ > 1) return std::make_unique<System>(system_, context_.calibration);
   return std::make_unique<System>(system_, context_.calibration, make_depth_source(), make_extractor());
 }
 

@@ -101,7 +101,7 @@ struct System::Impl {
   Tracker tracker;
   LocalMapper mapper;
   LoopCloser closer;
-  FrameBuilder builder;  // for track(SensorFrame): the depth source and the extractor
+  std::optional<FrameBuilder> builder;  // for track(SensorFrame): the depth source and the extractor
   std::vector<FrameRecord> records;
 
   std::vector<LoopClosure> closures;  // every closure so far (threaded: guarded by results_mutex)
@@ -155,7 +155,8 @@ struct System::Impl {
 
   Impl(SystemOptions o, CameraCalibration c, std::unique_ptr<DepthSource> d, FeatureExtractor e)
       : options(o), calibration(c), map(o.map), tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping),
-        closer(c.camera, o.loop_closing), builder(c, o.depth_noise, std::move(d), std::move(e)) {
+        closer(c.camera, o.loop_closing) {
+    if (d) builder.emplace(c, o.depth_noise, std::move(d), std::move(e));
     if (threaded_loop_closing()) loop_thread = std::thread([this] { run_loop_closing(); });
     if (options.threaded_mapping) mapping_thread = std::thread([this] { run_mapping(); });
   }
@@ -230,6 +231,12 @@ System::System(SystemOptions options, CameraCalibration calibration, std::unique
   impl_ = std::make_unique<Impl>(options, calibration, std::move(depth), std::move(extractor));
 }
 
+System::System(SystemOptions options, CameraCalibration calibration) {
+  options.validate();
+  calibration.camera.validate();
+  impl_ = std::make_unique<Impl>(options, calibration, nullptr, FeatureExtractor{});
+}
+
 System::~System() {
   if (!impl_) return;
   if (impl_->mapping_thread.joinable()) {  // first: it feeds the loop thread
@@ -256,7 +263,12 @@ void System::finish() {
   impl_->rethrow_worker_error();
 }
 
-TrackResult System::track(const SensorFrame& sensor) { return track(sensor, impl_->builder.build(sensor)); }
+TrackResult System::track(const SensorFrame& sensor) {
+  if (!impl_->builder) {
+    throw std::logic_error("System::track(sensor): this System has no depth source and extractor; pass the built frame");
+  }
+  return track(sensor, impl_->builder->build(sensor));
+}
 
 TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   Impl& s = *impl_;

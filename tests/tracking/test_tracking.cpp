@@ -2,6 +2,7 @@
 #include "reliability/failure_run.hpp"
 #include "rgbl/core/error.hpp"
 #include "rgbl/tracking/frame.hpp"
+#include "rgbl/tracking/frame_builder.hpp"
 #include "rgbl/tracking/system.hpp"
 #include "support/data.hpp"
 
@@ -9,7 +10,9 @@
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <random>
+#include <stdexcept>
 
 namespace {
 
@@ -156,3 +159,34 @@ TEST_CASE("relocalisation neither changes nor depends on the caller's OpenCV gen
 }
 
 // The threaded-mapping test lives in tests/reliability/test_threaded.cpp (label `threaded`, run under TSan).
+
+TEST_CASE("a System without a depth source of its own tracks built frames, the same as one with it") {
+  const auto dir = rgbl::test::kitti_seq04();
+  if (!dir) return;
+  const auto sequence = rgbl::open_kitti_odometry(*dir);
+  const rgbl::CameraCalibration calibration = sequence->calibration().camera(0);
+  rgbl::DepthSourceContext context;
+  context.calibration = calibration;
+  const rgbl::SystemOptions options;
+  auto orb = std::make_shared<rgbl::OrbExtractor>();
+  rgbl::FrameBuilder builder(calibration, options.depth_noise, rgbl::make_lidar_source({}, context),
+                             [orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
+                               orb->extract(g, k, d);
+                             });
+  rgbl::System system(options, calibration);
+  constexpr std::size_t kFrames = 12;
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    const rgbl::FrameInput input = sequence->load(i);
+    rgbl::SensorFrame frame = rgbl::test::sensor_frame(input, 0);
+    frame.index = i;
+    if (i == 0) CHECK_THROWS_AS(system.track(frame), std::logic_error);  // nothing to build it with
+    CHECK(rgbl::has_pose(system.track(frame, builder.build(frame)).state));
+  }
+  const auto own = rgbl::test::run_sequence(*dir, 0, kFrames);
+  const auto built = system.trajectory();
+  REQUIRE(built.size() == kFrames);
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    const Eigen::Isometry3d T_world_cam0 = calibration.T_cam_cam0.inverse() * built[i].T_world_cam * calibration.T_cam_cam0;
+    CHECK(T_world_cam0.matrix() == own.estimate[i].matrix());
+  }
+}

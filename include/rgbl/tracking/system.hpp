@@ -87,6 +87,9 @@ class System {
  public:
   System(SystemOptions options, CameraCalibration calibration, std::unique_ptr<DepthSource> depth,
          FeatureExtractor extractor);
+  // Without a depth source and an extractor of its own: every frame comes built (track(sensor, prepared),
+  // e.g. by FrameBuilders on other threads); track(sensor) throws std::logic_error.
+  System(SystemOptions options, CameraCalibration calibration);
   ~System();
   System(const System&) = delete;
   System& operator=(const System&) = delete;
