@@ -126,6 +126,22 @@ void bind_io(py::module_& m) {
           "ParseError naming a missing or corrupt file.");
 
   m.def(
+      "check_sequence",
+      [](const Sequence& sequence) {
+        std::vector<LoadProblem> problems;
+        {
+          const py::gil_scoped_release release;
+          problems = check_sequence(sequence);
+        }
+        py::list out;
+        for (const LoadProblem& p : problems) out.append(py::make_tuple(p.frame, p.message));
+        return out;
+      },
+      py::arg("sequence"),
+      "Loads every file of every frame, one sensor at a time: a (frame, message) per file that does not load "
+      "(the message names the file); empty when all load. What `rgbl info --check` lists.");
+
+  m.def(
       "open_sequence",
       [](const std::filesystem::path& path, const std::string& format,
          const std::optional<std::array<bool, 4>>& cameras, bool lidar, bool depth) {

@@ -84,6 +84,9 @@ void bind_pipeline(py::module_& m) {
       .def_readonly("stopped", &RunResult::stopped, "Stopped on request before the last frame: every output is partial.")
       .def("count", &RunResult::count, py::arg("state"), "Frames in a TrackState.")
       .def("tracked_count", &RunResult::tracked_count, "Frames with a tracked pose (ok or weak).")
+      .def("failed", &RunResult::failed,
+           "No frame tracked in a whole run: the trajectory is guesses (write_outputs writes timing.csv and "
+           "summary.json alone).")
       .def("keyframe_count", &RunResult::keyframe_count)
       .def("timings", &RunResult::timings)
       .def("summary_json", &summary_json, "summary.json's content.")
@@ -91,7 +94,7 @@ void bind_pipeline(py::module_& m) {
            [](const RunResult& r, const std::filesystem::path& out_dir) { write_run_outputs(r, out_dir); },
            py::arg("out_dir"),
            "Writes what `rgbl run` writes: trajectory_kitti.txt, trajectory_tum.txt, ground_truth_kitti.txt, "
-           "timing.csv, summary.json, trajectory.svg, map.ply.");
+           "timing.csv, summary.json, trajectory.svg, map.ply (a failed() run: timing.csv and summary.json).");
 
   m.def("write_run_outputs",
         [](const RunResult& r, const std::filesystem::path& out_dir) { write_run_outputs(r, out_dir); },

@@ -1,5 +1,7 @@
 """Sequences and frames: numpy views of the loaded data."""
 
+import shutil
+
 import numpy as np
 import pytest
 
@@ -41,3 +43,23 @@ def test_scan_file_is_viewed_as_n_by_4(short_street):
     raw = np.fromfile(short_street.sequence_dir / "velodyne" / "000000.bin", np.float32).reshape(-1, 4)
     assert np.array_equal(scan, raw)
     assert not scan.flags.owndata
+
+
+def test_check_sequence_lists_every_file_that_does_not_load(short_street, tmp_path):
+    assert rgbl.check_sequence(rgbl.open_sequence(short_street.sequence_dir)) == []
+    copy = tmp_path / "sequences" / "00"
+    shutil.copytree(short_street.sequence_dir, copy)
+    (copy / "image_0" / "000001.png").write_bytes(b"not a PNG")
+    (copy / "velodyne" / "000002.bin").write_bytes(b"twenty bytes of junk")
+    problems = rgbl.check_sequence(rgbl.open_sequence(copy))
+    assert [frame for frame, _ in problems] == [1, 2]
+    assert "image_0/000001.png" in problems[0][1] and "velodyne/000002.bin" in problems[1][1]
+
+
+def test_synthetic_street_options_are_checked_by_name(tmp_path):
+    with pytest.raises(rgbl.ConfigError, match="'path'"):
+        rgbl.write_synthetic_kitti(tmp_path / "a", path="spiral")
+    with pytest.raises(rgbl.ConfigError, match="'laps'"):
+        rgbl.write_synthetic_kitti(tmp_path / "b", path="curve", laps=2)
+    with pytest.raises(rgbl.ConfigError, match="'scenario'"):
+        rgbl.write_synthetic_kitti(tmp_path / "c", scenario="nope")

@@ -10,7 +10,7 @@
 namespace rgbl {
 
 void DemoOptions::validate() const {
-  if (scenario.empty() && !parse_path_kind(path)) throw ConfigError("path", "straight, curve or loop");
+  if (scenario.empty() && !parse_path_kind(path)) throw ConfigError("path", "straight, curve, loop or turn");
   require(frames >= 0, "frames", ">= 0 (0: the default)");
   require(laps >= 1, "laps", ">= 1");
   if (laps != 1 && (!scenario.empty() || path != "loop")) {

@@ -199,8 +199,6 @@ SensorFrame Pipeline::sensor_frame(const FrameInput& input) const {
 }
 
 std::unique_ptr<System> Pipeline::make_system() const {
-  // with frame threads every frame is built by a FrameBuilder of run()'s, none by the System
-  if (threads_ > 1) return std::make_unique<System>(system_, context_.calibration);
   return std::make_unique<System>(system_, context_.calibration, make_depth_source(), make_extractor());
 }
 
@@ -216,7 +214,9 @@ struct InFlight {
 }  // namespace
 
 RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
-  const std::unique_ptr<System> system = make_system();
+  // with frame threads every frame is built by one of the FrameBuilders below, none by the System
+  const std::unique_ptr<System> system =
+      threads_ > 1 ? std::make_unique<System>(system_, context_.calibration) : make_system();
   ReadAhead frames(*sequence_, read_ahead_options());
   std::vector<FrameRecord> records;
   records.reserve(count_);

@@ -15,7 +15,7 @@ namespace rgbl {
 
 struct DemoOptions {
   std::string scenario;         // a scenario's name (scenarios()); empty: the street of `path`
-  std::string path = "curve";   // straight, curve or loop, without a scenario
+  std::string path = "curve";   // straight, curve, loop or turn, without a scenario
   int frames = 0;               // 0: a scenario's own; on a path 60, or 80 per lap of a loop
   int laps = 1;                 // of a loop (2: past the start and round again)
   std::uint64_t seed = 1;       // of the scene and all noise
