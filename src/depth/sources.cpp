@@ -2,6 +2,7 @@
 
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/file.hpp"
+#include "rgbl/io/image.hpp"
 #include "source_checks.hpp"
 
 #include <fmt/format.h>
@@ -64,12 +65,8 @@ cv::Mat_<float> read_depth_png(const std::filesystem::path& file) {
 }
 
 void write_depth_png(const std::filesystem::path& file, const cv::Mat_<float>& depth) {
-  cv::Mat raw;
-  depth.convertTo(raw, CV_16U, 256.0);  // saturating
-  std::vector<unsigned char> png;
-  if (!cv::imencode(".png", raw, png)) throw ParseError(file, 0, "a depth map that encodes as PNG");
   // atomically: a reader (a run using --depth precomputed) never sees half a map
-  write_atomically(file, png);
+  write_png_file(file, encode_depth16(depth));
 }
 
 void sample_dense_depth(const cv::Mat_<float>& dense, const Kernel& kernel, std::span<const Eigen::Vector2f> pixels,

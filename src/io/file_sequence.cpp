@@ -10,6 +10,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cmath>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -154,6 +156,19 @@ void write_png_file(const std::filesystem::path& file, const cv::Mat& image) {
                             image.rows, image.type()));
   }
   write_atomically(file, png);
+}
+
+cv::Mat encode_depth16(const cv::Mat_<float>& depth) {
+  cv::Mat_<std::uint16_t> out(depth.rows, depth.cols);
+  for (int v = 0; v < depth.rows; ++v) {
+    const float* in = depth[v];
+    std::uint16_t* row = out[v];
+    for (int u = 0; u < depth.cols; ++u) {
+      const double scaled = std::round(static_cast<double>(in[u]) * 256.0);
+      row[u] = scaled > 0.0 && scaled <= 65535.0 ? static_cast<std::uint16_t>(scaled) : 0;
+    }
+  }
+  return out;
 }
 
 cv::Mat read_image_file(const std::filesystem::path& file, int flags) {

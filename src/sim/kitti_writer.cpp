@@ -49,7 +49,7 @@ class SequenceWriter {
       const cv::Mat& image = f.images[static_cast<std::size_t>(c)];
       if (!image.empty()) write_png_file(layout_.sequence_dir / fmt::format("image_{}", c) / (name + ".png"), image);
     }
-    if (!f.depth.empty()) write_depth(layout_.sequence_dir / "depth" / (name + ".png"), f.depth);
+    if (!f.depth.empty()) write_png_file(layout_.sequence_dir / "depth" / (name + ".png"), encode_depth16(f.depth));
     const auto bin = layout_.sequence_dir / "velodyne" / (name + ".bin");
     std::ofstream out(bin, std::ios::binary);
     if (!f.scan.empty()) {  // a dropped scan is an empty file
@@ -77,19 +77,6 @@ class SequenceWriter {
       for (int c = 0; c < 4; ++c) s += fmt::format("{}{:.12e}", s.empty() ? "" : " ", M(r, c) + 0.0);  // no "-0"
     return s;
   }
-
-  static void write_depth(const std::filesystem::path& file, const cv::Mat_<float>& depth) {
-    // uint16 = depth * 256 (KITTI depth-completion convention); beyond 255.99 m: 0.
-    cv::Mat depth16(depth.rows, depth.cols, CV_16UC1);
-    for (int v = 0; v < depth.rows; ++v) {
-      for (int u = 0; u < depth.cols; ++u) {
-        const double scaled = std::round(static_cast<double>(depth(v, u)) * 256.0);
-        depth16.at<std::uint16_t>(v, u) = scaled > 0.0 && scaled <= 65535.0 ? static_cast<std::uint16_t>(scaled) : 0;
-      }
-    }
-    write_png_file(file, depth16);
-  }
-
 
   void write_calibration(const KittiCalibration& calibration) const {
     const auto file = layout_.sequence_dir / "calib.txt";

@@ -1,6 +1,7 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/depth/completion.hpp"
 #include "rgbl/depth/sources.hpp"
+#include "rgbl/io/image.hpp"
 #include "rgbl/geometry/calibration.hpp"
 #include "support/data.hpp"
 #include "support/temp_dir.hpp"
@@ -9,7 +10,10 @@
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
 
+#include <cstdint>
 #include <cstring>
+#include <limits>
+#include <utility>
 
 using Catch::Matchers::Contains;
 
@@ -175,6 +179,29 @@ TEST_CASE("lidar source on real frames: keypoint samples equal the dense map (di
   CHECK(off_surface == 0);
   CHECK(changed > 0);
   CHECK(with_depth > pixels.size() / 5);
+}
+
+TEST_CASE("depth PNGs: depth x 256 rounded, 0 for no depth and for depths that do not fit") {
+  rgbl::test::TempDir dir;
+  cv::Mat_<float> depth(2, 4, 0.0F);
+  depth(0, 0) = 10.5F;                                     // exact
+  depth(0, 1) = 1.0F / 512.0F + 1e-4F;                     // rounds to 1 / 256
+  depth(0, 2) = 255.99F;                                   // the largest that fits
+  depth(0, 3) = 300.0F;                                    // does not fit: no depth, not a false 256 m
+  depth(1, 0) = -2.0F;
+  depth(1, 1) = std::numeric_limits<float>::quiet_NaN();
+  depth(1, 2) = std::numeric_limits<float>::infinity();
+  rgbl::write_depth_png(dir.path() / "d.png", depth);
+  const cv::Mat_<float> back = rgbl::read_depth_png(dir.path() / "d.png");
+  CHECK(back(0, 0) == 10.5F);
+  CHECK(back(0, 1) == 1.0F / 256.0F);
+  CHECK(back(0, 2) == Approx(255.99F).margin(1.0 / 512.0));
+  for (const auto& [v, u] : {std::pair{0, 3}, {1, 0}, {1, 1}, {1, 2}, {1, 3}}) CHECK(back(v, u) == 0.0F);
+  // the simulator's exact depth is written by the same encoder (rgbl::encode_depth16)
+  const cv::Mat encoded = rgbl::encode_depth16(depth);
+  CHECK(encoded.type() == CV_16UC1);
+  CHECK(encoded.at<std::uint16_t>(0, 2) == 65533);
+  CHECK(encoded.at<std::uint16_t>(0, 3) == 0);
 }
 
 TEST_CASE("precomputed source: reads PNGs, drops the top fraction and far depths, names missing files") {

@@ -127,7 +127,8 @@ DepthSourceRegistry builtin_depth_sources();
 
 // Reads a depth PNG (uint16, depth x 256) into metres. Throws ParseError naming the file.
 cv::Mat_<float> read_depth_png(const std::filesystem::path& file);
-// Writes metres as uint16 PNG (depth x 256, clamped to the uint16 range). Throws ParseError on failure.
+// Writes metres as uint16 PNG (encode_depth16 of rgbl/io/image.hpp: depth x 256, 0 = none, also for
+// depths beyond 255.996 m), atomically. Throws Error naming the file on failure.
 void write_depth_png(const std::filesystem::path& file, const cv::Mat_<float>& depth);
 
 // Depth at keypoints read from a dense map: z at the nearest pixel centre, sample_distance_px the

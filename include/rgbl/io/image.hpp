@@ -17,4 +17,9 @@ cv::Mat read_image_file(const std::filesystem::path& file, int flags);
 // sees half a file, an interrupted writer leaves none. Throws Error naming the file.
 void write_png_file(const std::filesystem::path& file, const cv::Mat& image);
 
+// Depth in metres as the 16-bit PNG value of KITTI depth completion: round(depth * 256). 0 means no
+// depth, and is also what a depth that does not fit gets (above 255.996 m, <= 0, NaN): a saturated
+// 65535 would read back as a false 256 m.
+cv::Mat encode_depth16(const cv::Mat_<float>& depth);
+
 }  // namespace rgbl
