@@ -90,7 +90,9 @@ if [ "$sim" = 1 ]; then
     if [ -n "$frames" ]; then echo "$frames"; return; fi
     awk -v s="$1" '$1 == s { if (match($0, /default [0-9]+ frames/)) print substr($0, RSTART + 8, RLENGTH - 15) }' <<< "$listing"
   }
-  key="$(cat "$repo"/src/sim/* "$repo"/include/rgbl/sim/* "$repo"/apps/rgbl/demo_command.cpp | sha1sum | cut -c1-12)"
+  # everything that shapes the written street: the simulator, the demo's options, the image writers
+  key="$(cat "$repo"/src/sim/* "$repo"/include/rgbl/sim/* "$repo"/apps/rgbl/demo_command.cpp "$repo"/src/pipeline/demo.cpp \
+    "$repo"/include/rgbl/pipeline/demo.hpp "$repo"/src/io/file_sequence.cpp | sha1sum | cut -c1-12)"
   echo "scenarios (seeds $seeds; cache $cache, key $key):"
   runs=()   # "name scenario frames"
   plain_default="$(length_of plain)"
