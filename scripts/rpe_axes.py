@@ -1,0 +1,62 @@
+#!/usr/bin/env python3
+"""Frame-to-frame pose error by axis, in the camera frame: where a trajectory's jitter and bias are.
+
+    scripts/rpe_axes.py <run folder of rgbl run / rgbl demo>   (trajectory_kitti.txt, ground_truth_kitti.txt)
+    scripts/rpe_axes.py <estimate.txt> <ground_truth.txt>      (KITTI format, row for row)
+
+For each pair of consecutive frames, E = (T_gt_i^-1 T_gt_i+1)^-1 (T_est_i^-1 T_est_i+1); prints the mean
+(bias) and RMS (jitter) of E's rotation about x (pitch), y (yaw), z (roll) in degrees and of its
+translation in metres (x right, y down, z forward). Needs python3-numpy.
+"""
+import pathlib
+import sys
+
+import numpy as np
+
+
+def load(path):
+    rows = np.loadtxt(path, ndmin=2)
+    poses = np.tile(np.eye(4), (len(rows), 1, 1))
+    poses[:, :3, :] = rows[:, -12:].reshape(-1, 3, 4)
+    return poses
+
+
+def rotation_vector(R):
+    angle = np.arccos(np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0))
+    if angle < 1e-12:
+        return np.zeros(3)
+    axis = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    return angle / (2.0 * np.sin(angle)) * axis
+
+
+def main():
+    if len(sys.argv) == 2:
+        run = pathlib.Path(sys.argv[1])
+        estimate, truth = run / "trajectory_kitti.txt", run / "ground_truth_kitti.txt"
+    elif len(sys.argv) == 3:
+        estimate, truth = sys.argv[1], sys.argv[2]
+    else:
+        sys.exit(__doc__)
+    est, gt = load(estimate), load(truth)
+    n = min(len(est), len(gt))
+    if n < 2:
+        sys.exit("error: fewer than 2 poses to compare")
+    rot, trans = [], []
+    for i in range(n - 1):
+        step_est = np.linalg.inv(est[i]) @ est[i + 1]
+        step_gt = np.linalg.inv(gt[i]) @ gt[i + 1]
+        E = np.linalg.inv(step_gt) @ step_est
+        rot.append(np.degrees(rotation_vector(E[:3, :3])))
+        trans.append(E[:3, 3])
+    rot, trans = np.array(rot), np.array(trans)
+    print(f"{n} frames")
+    print("rotation deg     pitch(x)  yaw(y)   roll(z)")
+    print("  mean (bias)   " + "".join(f"{v:9.4f}" for v in rot.mean(axis=0)))
+    print("  rms (jitter)  " + "".join(f"{v:9.4f}" for v in np.sqrt((rot ** 2).mean(axis=0))))
+    print("translation m    x        y(down)  z(fwd)")
+    print("  mean (bias)   " + "".join(f"{v:9.4f}" for v in trans.mean(axis=0)))
+    print("  rms (jitter)  " + "".join(f"{v:9.4f}" for v in np.sqrt((trans ** 2).mean(axis=0))))
+
+
+if __name__ == "__main__":
+    main()
