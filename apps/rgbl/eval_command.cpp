@@ -6,7 +6,6 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
-#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -26,38 +25,7 @@ struct EvalArgs {
 
 int run_eval(const EvalArgs& args) {
   const TrajectoryComparison c = compare_trajectory_files(args.estimate, args.ground_truth, args.options);
-  const TrajectoryEvaluation& e = c.evaluation;
-  const KittiMetric& metric = e.kitti;
-  const AteResult& ate = e.ate;
-  const RpeResult& rpe = e.rpe;
-  const DriftResult& drift = e.drift;
-  fmt::print("estimate:      {} ({}, {} poses)\n", args.estimate.string(), c.format, c.estimated_poses);
-  fmt::print("ground truth:  {} ({})\n", args.ground_truth.string(), c.format);
-  for (const auto& note : c.notes) fmt::print("note:          {}\n", note);
-  fmt::print("path length:   {:.3f} m\n\n", e.path_length);
-  fmt::print("KITTI odometry metric (devkit definition: a segment every {} frames, mean over all segments)\n",
-             e.kitti_options.step_size);
-  fmt::print("  {:>10}  {:>8}  {:>10}  {:>16}\n", "length [m]", "segments", "t_err [%]", "r_err [deg/100m]");
-  const auto cell = [](double v, int width) {
-    return std::isfinite(v) ? fmt::format("{:>{}.4f}", v, width) : fmt::format("{:>{}}", "-", width);
-  };
-  for (const auto& l : metric.per_length) {
-    fmt::print("  {:>10g}  {:>8}  {}  {}\n", l.length, l.segments, cell(l.t_err_percent, 10),
-               cell(l.r_err_deg_per_100m, 16));
-  }
-  fmt::print("  {:>10}  {:>8}  {}  {}\n", "all", metric.segments, cell(metric.t_err_percent, 10),
-             cell(metric.r_err_deg_per_100m, 16));
-  if (metric.segments == 0) {
-    fmt::print("  (no segment fits in the path: pass shorter --lengths)\n");
-  }
-  fmt::print("\nATE (rigid SE3 alignment, no scale) [m]: rmse {:.4f}  mean {:.4f}  median {:.4f}  max {:.4f}\n",
-             ate.translation.rmse, ate.translation.mean, ate.translation.median, ate.translation.max);
-  fmt::print("RPE per frame, translation [m]:          rmse {:.4f}  mean {:.4f}  median {:.4f}  max {:.4f}\n",
-             rpe.translation.rmse, rpe.translation.mean, rpe.translation.median, rpe.translation.max);
-  fmt::print("RPE per frame, rotation [deg]:           rmse {:.4f}  mean {:.4f}  median {:.4f}  max {:.4f}\n",
-             rpe.rotation_deg.rmse, rpe.rotation_deg.mean, rpe.rotation_deg.median, rpe.rotation_deg.max);
-  fmt::print("end-point drift: {:.4f} m = {:.4f} % of the path\n", drift.end_error, drift.percent);
-
+  fmt::print("{}", comparison_text(c));
   if (args.json == "-") {
     fmt::print("{}", comparison_json(c));
   } else if (!args.json.empty()) {

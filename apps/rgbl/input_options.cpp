@@ -6,7 +6,6 @@
 #include "rgbl/core/timer.hpp"
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -15,57 +14,11 @@
 namespace rgbl::cli {
 namespace {
 
-void print_summary(const RunResult& run, const std::filesystem::path& out_dir, bool failed) {
-  const RunTimings t = run.timings();
-  fmt::print("\n{} ({}), camera {}, depth {}: {} frames in {:.1f} s\n", run.sequence_name, to_string(run.format),
-             run.camera, run.depth, run.frames.size(), run.wall_s);
-  if (run.stopped) {
-    fmt::print("  PARTIAL: stopped after {} of {} frames; every output holds only these\n", run.frames.size(),
-               run.frames_planned);
-  }
-  fmt::print("  ok {}, weak {}, lost {}, not initialised {}; {} keyframes, {} landmarks\n",
-             run.count(TrackState::Ok), run.count(TrackState::Weak), run.count(TrackState::Lost),
-             run.count(TrackState::NotInitialised), run.keyframe_count(), run.landmarks.size());
-  const auto jumps = run.frames_where([](const TrackResult& r) { return r.jump; });
-  const auto new_maps = run.frames_where([](const TrackResult& r) { return r.new_map; });
-  if (!jumps.empty()) fmt::print("  steps beyond a vehicle's reach taken at frame(s) {}\n", fmt::join(jumps, ", "));
-  if (!new_maps.empty()) {
-    fmt::print("  lost beyond relocalisation: new map started at frame(s) {}\n", fmt::join(new_maps, ", "));
-  }
-  if (run.loop_statistics.implausible > 0) {
-    fmt::print("  loop closing refused {} verified loop(s) asking for more correction than odometry can drift\n",
-               run.loop_statistics.implausible);
-  }
-  for (const LoopClosure& c : run.loop_closures) {
-    fmt::print("  {} at frame {} with frame {}: map moved {:.2f} m / {:.2f} deg there, {} landmarks fused, "
-               "{:.0f} ms (global BA of {} keyframes {:.0f} ms)\n",
-               c.merged ? "maps merged" : "loop closed", c.frame_index, c.matched_frame_index, c.correction_m,
-               c.correction_deg, c.fused_landmarks, c.time_ms, c.global_ba_keyframes, c.global_ba_ms);
-  }
-  fmt::print("  per frame (median / p95 ms): depth {:.2f} / {:.2f}, extraction {:.2f} / {:.2f}, tracking {:.2f} / "
-             "{:.2f}, mapping {:.2f} / {:.2f}\n",
-             t.depth.median, t.depth.p95, t.extraction.median, t.extraction.p95, t.tracking.median, t.tracking.p95,
-             t.mapping.median, t.mapping.p95);
-  fmt::print("  depth+extraction+tracking {:.2f} ms median; total {:.2f} ms median, {:.2f} ms mean\n", t.front.median,
-             t.total.median, t.total.mean);
-  if (run.metrics) {
-    const RunMetrics& m = *run.metrics;
-    const TrajectoryEvaluation& e = m.evaluation;
-    if (m.frames_tracked < m.frames_with_ground_truth) {
-      // untracked frames carry guesses: the tracked frames' own figure first, the whole run's beside it
-      const std::string tracked = m.tracked_ate ? fmt::format("{:.3f} m", m.tracked_ate->translation.rmse) : "n/a";
-      fmt::print("  tracked {} of {} frames with ground truth: ATE RMSE {} over those; over all frames (the "
-                 "untracked at their guessed pose):\n", m.frames_tracked, m.frames_with_ground_truth, tracked);
-    }
-    fmt::print("  ATE RMSE {:.3f} m, end-point drift {:.2f} %, KITTI metric ({}) {:.2f} % / {:.3f} deg/100m\n",
-               e.ate.translation.rmse, e.drift.percent, m.kitti_lengths, e.kitti.t_err_percent,
-               e.kitti.r_err_deg_per_100m);
-  } else {
-    fmt::print("  no ground truth: no accuracy figures\n");
-  }
+void print_summary(const RunResult& run, const std::filesystem::path& out_dir) {
+  fmt::print("\n{}", summary_text(run));
   fmt::print("  outputs in {}: {}\n", out_dir.string(),
-             failed ? "timing.csv summary.json (no trajectory: nothing was tracked)"
-                    : "trajectory_kitti.txt trajectory_tum.txt timing.csv summary.json trajectory.svg map.ply");
+             run.failed() ? "timing.csv summary.json (no trajectory: nothing was tracked)"
+                          : "trajectory_kitti.txt trajectory_tum.txt timing.csv summary.json trajectory.svg map.ply");
 }
 
 }  // namespace
@@ -119,7 +72,7 @@ RunResult run_and_report(const Pipeline& pipeline, const OutputFolder& out_dir, 
                "\"partial\": true)\n", interrupt.signal_name(), run.frames.size(), run.frames_planned);
   }
   write_run_outputs(run, out_dir);  // a failed run: timing.csv and summary.json alone, to tell why
-  print_summary(run, out_dir.path(), run.failed());
+  print_summary(run, out_dir.path());
   if (run.failed()) {
     throw Error(fmt::format("no frame of {} was tracked ({} not initialised, {} lost); the reasons are printed "
                             "with -v, per-frame states in {}",

@@ -140,6 +140,9 @@ class Sequence:
 def check_sequence(sequence: Sequence) -> List[Tuple[int, str]]:
     """A (frame, message) per file that does not load, one sensor at a time; empty when all load."""
 
+def describe_sequence(sequence: Sequence) -> str:
+    """What `rgbl info` prints: layout, frames, cameras, LiDAR, depth camera, ground truth, notes."""
+
 def open_sequence(path: _Path, format: str = "auto", cameras: Optional[_Seq[bool]] = None, lidar: bool = True,
                   depth: bool = True) -> Sequence:
     """KITTI odometry sequences/NN, a KITTI raw drive or a TUM RGB-D folder ('auto', 'kitti', 'kitti-raw', 'tum')."""
@@ -432,6 +435,8 @@ class RunResult:
     def keyframe_count(self) -> int: ...
     def timings(self) -> RunTimings: ...
     def summary_json(self) -> str: ...
+    def summary_text(self) -> str:
+        """The run in a few lines, as `rgbl run` prints it (also str(result))."""
     def write_outputs(self, out_dir: _Path) -> None: ...
 
 def write_run_outputs(result: RunResult, out_dir: _Path) -> None: ...

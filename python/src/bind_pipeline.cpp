@@ -2,6 +2,7 @@
 
 #include "common.hpp"
 
+#include "rgbl/pipeline/describe.hpp"
 #include "rgbl/pipeline/pipeline.hpp"
 
 #include <optional>
@@ -90,11 +91,22 @@ void bind_pipeline(py::module_& m) {
       .def("keyframe_count", &RunResult::keyframe_count)
       .def("timings", &RunResult::timings)
       .def("summary_json", &summary_json, "summary.json's content.")
+      .def("summary_text", &summary_text, "The run in a few lines, as `rgbl run` prints it.")
+      .def("__str__", &summary_text)
       .def("write_outputs",
            [](const RunResult& r, const std::filesystem::path& out_dir) { write_run_outputs(r, out_dir); },
            py::arg("out_dir"),
            "Writes what `rgbl run` writes: trajectory_kitti.txt, trajectory_tum.txt, ground_truth_kitti.txt, "
            "timing.csv, summary.json, trajectory.svg, map.ply (a failed() run: timing.csv and summary.json).");
+
+  m.def(
+      "describe_sequence",
+      [](const Sequence& sequence) {
+        const py::gil_scoped_release release;  // reads frame 0's scan
+        return describe_sequence(sequence);
+      },
+      py::arg("sequence"),
+      "What `rgbl info` prints: layout, frames, cameras, LiDAR, depth camera, ground truth and the loader's notes.");
 
   m.def("write_run_outputs",
         [](const RunResult& r, const std::filesystem::path& out_dir) { write_run_outputs(r, out_dir); },

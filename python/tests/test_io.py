@@ -56,6 +56,13 @@ def test_check_sequence_lists_every_file_that_does_not_load(short_street, tmp_pa
     assert "image_0/000001.png" in problems[0][1] and "velodyne/000002.bin" in problems[1][1]
 
 
+def test_describe_sequence_says_what_the_loader_sees(short_street):
+    sequence = rgbl.open_sequence(short_street.sequence_dir)
+    text = rgbl.describe_sequence(sequence)
+    assert f"frames:        {len(sequence)} over" in text
+    assert "camera 0:      grey left" in text and "lidar:         " in text and "ground truth:  " in text
+
+
 def test_synthetic_street_options_are_checked_by_name(tmp_path):
     with pytest.raises(rgbl.ConfigError, match="'path'"):
         rgbl.write_synthetic_kitti(tmp_path / "a", path="spiral")

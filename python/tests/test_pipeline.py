@@ -28,6 +28,10 @@ def test_pipeline_runs_with_progress(street):
     assert result.landmarks.shape[1] == 3 and len(result.landmarks) > 100
     assert len(result.keyframes) == result.keyframe_count() >= 2
     assert result.timings().total.median > 0
+    # the summary `rgbl run` prints, with this run's figures
+    text = str(result)
+    assert text == result.summary_text() and "ok 11, weak 0, lost 0" in text
+    assert f"ATE RMSE {ate:.3f} m" in text
     # views of the result's buffers
     assert np.shares_memory(result.trajectory.poses, result.trajectory.poses)
 

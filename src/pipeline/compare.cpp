@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <system_error>
 
@@ -173,6 +174,44 @@ std::string comparison_json(const TrajectoryComparison& c) {
                      {"drift", {{"end_error_m", number(e.drift.end_error)}, {"percent", number(e.drift.percent)}}}};
   // a path that is not UTF-8 is written with replacement characters rather than failing the report
   return json.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
+}
+
+}  // namespace rgbl
+
+namespace rgbl {
+
+std::string comparison_text(const TrajectoryComparison& c) {
+  const TrajectoryEvaluation& e = c.evaluation;
+  const KittiMetric& metric = e.kitti;
+  std::string s;
+  const auto out = std::back_inserter(s);
+  fmt::format_to(out, "estimate:      {} ({}, {} poses)\n", c.estimate.string(), c.format, c.estimated_poses);
+  fmt::format_to(out, "ground truth:  {} ({})\n", c.ground_truth.string(), c.format);
+  for (const auto& note : c.notes) fmt::format_to(out, "note:          {}\n", note);
+  fmt::format_to(out, "path length:   {:.3f} m\n\n", e.path_length);
+  fmt::format_to(out, "KITTI odometry metric (devkit definition: a segment every {} frames, mean over all segments)\n",
+                 e.kitti_options.step_size);
+  fmt::format_to(out, "  {:>10}  {:>8}  {:>10}  {:>16}\n", "length [m]", "segments", "t_err [%]", "r_err [deg/100m]");
+  const auto cell = [](double v, int width) {
+    return std::isfinite(v) ? fmt::format("{:>{}.4f}", v, width) : fmt::format("{:>{}}", "-", width);
+  };
+  for (const auto& l : metric.per_length) {
+    fmt::format_to(out, "  {:>10g}  {:>8}  {}  {}\n", l.length, l.segments, cell(l.t_err_percent, 10),
+                   cell(l.r_err_deg_per_100m, 16));
+  }
+  fmt::format_to(out, "  {:>10}  {:>8}  {}  {}\n", "all", metric.segments, cell(metric.t_err_percent, 10),
+                 cell(metric.r_err_deg_per_100m, 16));
+  if (metric.segments == 0) fmt::format_to(out, "  (no segment fits in the path: pass shorter --lengths)\n");
+  const auto stats = [&out](const char* label, const ErrorStats& x) {
+    fmt::format_to(out, "{:<41}rmse {:.4f}  mean {:.4f}  median {:.4f}  max {:.4f}\n", label, x.rmse, x.mean,
+                   x.median, x.max);
+  };
+  fmt::format_to(out, "\n");
+  stats("ATE (rigid SE3 alignment, no scale) [m]:", e.ate.translation);
+  stats("RPE per frame, translation [m]:", e.rpe.translation);
+  stats("RPE per frame, rotation [deg]:", e.rpe.rotation_deg);
+  fmt::format_to(out, "end-point drift: {:.4f} m = {:.4f} % of the path\n", e.drift.end_error, e.drift.percent);
+  return s;
 }
 
 }  // namespace rgbl

@@ -9,8 +9,10 @@
 #include "json.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
+#include <iterator>
 #include <system_error>
 #include <unordered_map>
 
@@ -185,6 +187,61 @@ std::string summary_json(const RunResult& run) {
   j["metrics"] = run.metrics ? metrics_json(*run.metrics) : Json(nullptr);
   // a path that is not UTF-8 is written with replacement characters rather than failing the outputs
   return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
+}
+
+std::string summary_text(const RunResult& run) {
+  const RunTimings t = run.timings();
+  std::string s;
+  const auto out = std::back_inserter(s);
+  fmt::format_to(out, "{} ({}), camera {}, depth {}: {} frames in {:.1f} s\n", run.sequence_name,
+                 to_string(run.format), run.camera, run.depth, run.frames.size(), run.wall_s);
+  if (run.stopped) {
+    fmt::format_to(out, "  PARTIAL: stopped after {} of {} frames; every output holds only these\n",
+                   run.frames.size(), run.frames_planned);
+  }
+  fmt::format_to(out, "  ok {}, weak {}, lost {}, not initialised {}; {} keyframes, {} landmarks\n",
+                 run.count(TrackState::Ok), run.count(TrackState::Weak), run.count(TrackState::Lost),
+                 run.count(TrackState::NotInitialised), run.keyframe_count(), run.landmarks.size());
+  const auto jumps = run.frames_where([](const TrackResult& r) { return r.jump; });
+  const auto new_maps = run.frames_where([](const TrackResult& r) { return r.new_map; });
+  if (!jumps.empty()) {
+    fmt::format_to(out, "  steps beyond a vehicle's reach taken at frame(s) {}\n", fmt::join(jumps, ", "));
+  }
+  if (!new_maps.empty()) {
+    fmt::format_to(out, "  lost beyond relocalisation: new map started at frame(s) {}\n", fmt::join(new_maps, ", "));
+  }
+  if (run.loop_statistics.implausible > 0) {
+    fmt::format_to(out, "  loop closing refused {} verified loop(s) asking for more correction than odometry can "
+                   "drift\n", run.loop_statistics.implausible);
+  }
+  for (const LoopClosure& c : run.loop_closures) {
+    fmt::format_to(out, "  {} at frame {} with frame {}: map moved {:.2f} m / {:.2f} deg there, {} landmarks fused, "
+                   "{:.0f} ms (global BA of {} keyframes {:.0f} ms)\n",
+                   c.merged ? "maps merged" : "loop closed", c.frame_index, c.matched_frame_index, c.correction_m,
+                   c.correction_deg, c.fused_landmarks, c.time_ms, c.global_ba_keyframes, c.global_ba_ms);
+  }
+  fmt::format_to(out, "  per frame (median / p95 ms): depth {:.2f} / {:.2f}, extraction {:.2f} / {:.2f}, tracking "
+                 "{:.2f} / {:.2f}, mapping {:.2f} / {:.2f}\n",
+                 t.depth.median, t.depth.p95, t.extraction.median, t.extraction.p95, t.tracking.median,
+                 t.tracking.p95, t.mapping.median, t.mapping.p95);
+  fmt::format_to(out, "  depth+extraction+tracking {:.2f} ms median; total {:.2f} ms median, {:.2f} ms mean\n",
+                 t.front.median, t.total.median, t.total.mean);
+  if (!run.metrics) {
+    fmt::format_to(out, "  no ground truth: no accuracy figures\n");
+    return s;
+  }
+  const RunMetrics& m = *run.metrics;
+  const TrajectoryEvaluation& e = m.evaluation;
+  if (m.frames_tracked < m.frames_with_ground_truth) {
+    // untracked frames carry guesses: the tracked frames' own figure first, the whole run's beside it
+    fmt::format_to(out, "  tracked {} of {} frames with ground truth: ATE RMSE {} over those; over all frames (the "
+                   "untracked at their guessed pose):\n", m.frames_tracked, m.frames_with_ground_truth,
+                   m.tracked_ate ? fmt::format("{:.3f} m", m.tracked_ate->translation.rmse) : "n/a");
+  }
+  fmt::format_to(out, "  ATE RMSE {:.3f} m, end-point drift {:.2f} %, KITTI metric ({}) {:.2f} % / {:.3f} deg/100m\n",
+                 e.ate.translation.rmse, e.drift.percent, m.kitti_lengths, e.kitti.t_err_percent,
+                 e.kitti.r_err_deg_per_100m);
+  return s;
 }
 
 void write_run_outputs(const RunResult& run, const std::filesystem::path& out_dir) {

@@ -2,6 +2,7 @@
 #include "rgbl/core/file.hpp"
 #include "rgbl/core/task_pool.hpp"
 #include "rgbl/pipeline/demo.hpp"
+#include "rgbl/pipeline/describe.hpp"
 #include "rgbl/pipeline/pipeline.hpp"
 #include "rgbl/sim/sim_sequence.hpp"
 #include "rgbl/sim/synthetic.hpp"
@@ -11,6 +12,7 @@
 
 #include <catch2/catch.hpp>
 #include <opencv2/core.hpp>
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -81,6 +83,11 @@ TEST_CASE("a pipeline tracks a sequence, re-expresses it in the ground truth's w
   REQUIRE(run.min_inliers_ok().has_value());
   CHECK(*run.min_inliers_ok() >= 30);
   CHECK(run.timings().total.median > 0.0);
+  // the summary people read carries the same figures
+  const std::string text = rgbl::summary_text(run);
+  CHECK_THAT(text, Catch::Contains("ok 18, weak 0, lost 0, not initialised 0"));
+  CHECK_THAT(text, Catch::Contains(fmt::format("ATE RMSE {:.3f} m", run.metrics->evaluation.ate.translation.rmse)));
+  CHECK_THAT(text, Catch::Contains(fmt::format("{} keyframes", run.keyframe_count())));
 
   // inline runs are reproducible to the bit
   const rgbl::RunResult again = pipeline.run();
@@ -107,6 +114,15 @@ TEST_CASE("a pipeline tracks a sequence, re-expresses it in the ground truth's w
   CHECK(std::count(rows.begin(), rows.end(), '\n') == 18);
   rgbl::remove_run_outputs(out.path() / "run");
   for (const auto& name : rgbl::run_output_files()) CHECK_FALSE(std::filesystem::exists(out.path() / "run" / name));
+}
+
+TEST_CASE("a sequence described as `rgbl info` prints it: its frames, sensors and ground truth") {
+  const auto seq = rgbl::open_sequence(curve().sequence_dir);
+  const std::string text = rgbl::describe_sequence(*seq);
+  CHECK_THAT(text, Catch::Contains(fmt::format("frames:        {} over", seq->size())));
+  CHECK_THAT(text, Catch::Contains("camera 0:      grey left"));
+  CHECK_THAT(text, Catch::Contains(fmt::format("lidar:         {} points in frame 0", seq->load(0).scan.size())));
+  CHECK_THAT(text, Catch::Contains(fmt::format("ground truth:  {} poses", seq->size())));
 }
 
 TEST_CASE("a run that tracks nothing says so in its metrics: no figure for tracked frames") {

@@ -1,6 +1,6 @@
 #pragma once
 // What `rgbl eval` does: an estimated trajectory file against a ground-truth file (KITTI rows or TUM
-// timestamps), every metric, and its JSON report.
+// timestamps), every metric, and its reports (text and JSON).
 
 #include "rgbl/eval/trajectory_metrics.hpp"
 
@@ -43,5 +43,9 @@ TrajectoryComparison compare_trajectory_files(const std::filesystem::path& estim
 
 // The comparison as JSON (kitti per length, ATE, RPE, drift; NaN as null).
 std::string comparison_json(const TrajectoryComparison& comparison);
+
+// The comparison for people, as `rgbl eval` prints it: the files, the notes, the KITTI metric per
+// segment length, ATE, RPE and end-point drift ("-" for a length no segment fits).
+std::string comparison_text(const TrajectoryComparison& comparison);
 
 }  // namespace rgbl

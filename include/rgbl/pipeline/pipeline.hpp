@@ -216,4 +216,8 @@ void write_run_outputs(const RunResult& result, const OutputFolder& out_dir);
 // summary.json's content.
 std::string summary_json(const RunResult& result);
 
+// The run in a few lines for people, as `rgbl run` prints it: frame states, keyframes, jumps, new maps,
+// loop closures, per-stage medians and p95s, and the accuracy when there is ground truth.
+std::string summary_text(const RunResult& result);
+
 }  // namespace rgbl
