@@ -245,33 +245,41 @@ Tracker::Hypothesis Tracker::relocalisation_hypothesis(Frame frame, KeyframeId r
 }
 
 Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const {
-  // Never take silently a step that a vehicle cannot make: only on the evidence a relocalisation
-  // needs (then reported), else try the local map from the prediction, else keep the prediction.
+  // Never take silently a step that a vehicle cannot make. The local map is searched from the
+  // prediction first: when it places the frame within a vehicle's reach on the support of an ok frame,
+  // that pose wins, however many points agree on the implausible one (they are then on something
+  // moving with the camera, e.g. a truck alongside at the ego speed). Else the step is taken on the
+  // evidence a relocalisation needs (and reported as a jump), else the frame keeps the prediction.
   const double dt = h.frame.timestamp - last_frame_->timestamp;
   const double predicted_step =
       (prediction.T_cam_world.inverse().translation() - prediction.T_last_world.inverse().translation()).norm();
   const StepCheck step = check_step(h.frame.T_cam_world, prediction.T_cam_world, predicted_step, dt, options_);
   if (step.plausible) return h;
-  if (h.inliers >= options_.min_jump_inliers && !h.weak) {
+  Frame candidate = h.frame;
+  candidate.T_cam_world = prediction.T_cam_world;
+  clear_matches(candidate);
+  ViewLog candidate_views;
+  const LocalMapResult from_prediction =
+      track_local_map(candidate, h.reference, h.relocalisation_frame, candidate_views);
+  const StepCheck candidate_step =
+      check_step(candidate.T_cam_world, prediction.T_cam_world, predicted_step, dt, options_);
+  const bool plausible_alternative = from_prediction.ok && candidate_step.plausible;
+  logger()->debug("frame {}: step {:.2f} m / {:.1f} deg off the prediction (allowed {:.2f} m) on {} inliers; "
+                  "from the prediction the local map finds {} ({:.2f} m off)", h.frame.index, step.translation_m,
+                  step.rotation_deg, step.allowed_translation_m, h.inliers, from_prediction.inliers,
+                  candidate_step.translation_m);
+  if (!plausible_alternative && h.inliers >= options_.min_jump_inliers && !h.weak) {
     h.jump = true;
     logger()->warn("frame {}: step {:.2f} m / {:.1f} deg off the constant-velocity prediction (allowed {:.2f} m), "
                    "taken on {} inliers", h.frame.index, step.translation_m, step.rotation_deg,
                    step.allowed_translation_m, h.inliers);
     return h;
   }
-  Frame candidate = h.frame;
-  candidate.T_cam_world = prediction.T_cam_world;
-  clear_matches(candidate);
-  const LocalMapResult from_prediction = track_local_map(candidate, h.reference, h.relocalisation_frame, views);
-  const StepCheck candidate_step =
-      check_step(candidate.T_cam_world, prediction.T_cam_world, predicted_step, dt, options_);
-  logger()->debug("frame {}: step {:.2f} m / {:.1f} deg off the prediction (allowed {:.2f} m) on {} inliers; "
-                  "from the prediction the local map finds {} ({:.2f} m off)", h.frame.index, step.translation_m,
-                  step.rotation_deg, step.allowed_translation_m, h.inliers, from_prediction.inliers,
-                  candidate_step.translation_m);
+  views.visible.insert(views.visible.end(), candidate_views.visible.begin(), candidate_views.visible.end());
+  views.found.insert(views.found.end(), candidate_views.found.begin(), candidate_views.found.end());
   // either way the frame is at (or near) the prediction: the local map searched there is its own
   h.reference = from_prediction.reference;
-  if (from_prediction.ok && candidate_step.plausible) {
+  if (plausible_alternative) {
     h.frame = std::move(candidate);
     h.inliers = count_tracked(h.frame);
     h.weak = false;

@@ -109,9 +109,10 @@ struct TrackerOptions {
   // Step plausibility: while the velocity comes from two consecutive tracked frames, a pose may differ
   // from the constant-velocity prediction by step_tolerance + step_tolerance_relative * |predicted step|
   // + max_acceleration * dt^2 / 2 (two pose estimates' noise, the velocity's own error, and a change of
-  // speed within a car's reach) and step_tolerance_rotation_deg. A larger step is taken only with
-  // min_jump_inliers (what a relocalisation needs) and is then reported as a jump; otherwise the frame
-  // is weak and placed at the prediction.
+  // speed within a car's reach) and step_tolerance_rotation_deg. For a larger step the local map is
+  // searched from the prediction: a plausible pose found there with an ok frame's support wins. Else
+  // the step is taken with min_jump_inliers (what a relocalisation needs) and reported as a jump;
+  // otherwise the frame is weak and placed at the prediction.
   bool check_steps = true;
   double step_tolerance = 0.25;            // m
   double step_tolerance_relative = 0.1;
