@@ -176,10 +176,6 @@ std::string comparison_json(const TrajectoryComparison& c) {
   return json.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
-}  // namespace rgbl
-
-namespace rgbl {
-
 std::string comparison_text(const TrajectoryComparison& c) {
   const TrajectoryEvaluation& e = c.evaluation;
   const KittiMetric& metric = e.kitti;

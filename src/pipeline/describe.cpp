@@ -22,14 +22,14 @@ std::string describe_sequence(const Sequence& seq) {
   const auto& calib = seq.calibration();
   const SensorSet& sensors = seq.sensors();
   static constexpr std::array<const char*, 4> kCameraNames = {"grey left", "grey right", "colour left", "colour right"};
-  for (int c = 0; c < 4; ++c) {
-    if (!sensors.cameras[static_cast<std::size_t>(c)]) continue;
-    const CameraCalibration cam = calib.camera(c);
+  for (std::size_t c = 0; c < kCameraNames.size(); ++c) {
+    if (!sensors.cameras[c]) continue;
+    const CameraCalibration cam = calib.camera(static_cast<int>(c));
     const Eigen::Vector3d t = cam.T_cam_cam0.translation();
     fmt::format_to(out,
                    "camera {}:      {:<12} {}x{}  fx {:.4f} fy {:.4f} cx {:.4f} cy {:.4f}  T_cam_cam0 t = ({:.4f}, "
                    "{:.4f}, {:.4f}) m\n",
-                   c, kCameraNames[static_cast<std::size_t>(c)], cam.camera.width, cam.camera.height, cam.camera.fx,
+                   c, kCameraNames[c], cam.camera.width, cam.camera.height, cam.camera.fx,
                    cam.camera.fy, cam.camera.cx, cam.camera.cy, t.x(), t.y(), t.z());
   }
   if (sensors.lidar) {
