@@ -1,0 +1,67 @@
+#pragma once
+// How well two LiDAR scans agree under a relative pose: the share of one scan's returns that land on
+// the other's. A pose decided from images can be wrong in ways images cannot tell (a car ahead at the
+// ego speed, road paint that repeats at the step length, motion blur that looks alike at zero
+// motion); the scans see the static world's shape whatever the images show, and a wrong pose moves
+// poles, trunks, kerbs and facades off each other.
+
+#include "rgbl/geometry/point_cloud.hpp"
+#include "rgbl/geometry/voxel_index.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace rgbl {
+
+struct ScanSampleOptions {
+  std::size_t stride = 8;    // every stride-th return (a KITTI scan: ~15k of ~120k)
+  double min_range = 2.0;    // m: nearer returns are the car itself
+  double max_range = 40.0;   // m: farther ones are too sparse to land on each other
+  double tolerance = 0.3;    // m: a return agrees when a return of the other scan lies this close
+
+  void validate() const;
+};
+
+// A subsample of a scan, in a camera frame (what a tracked frame keeps of its scan).
+struct ScanSample {
+  std::vector<Eigen::Vector3f> points;
+  bool empty() const { return points.empty(); }
+};
+
+ScanSample sample_scan(PointCloudView scan, const Eigen::Isometry3d& T_cam_lidar, const ScanSampleOptions& options);
+
+// How the points of one sample vote between two poses of it against a reference: the points that
+// land on the reference under one pose and not under the other.
+struct ScanVote {
+  std::size_t only_a = 0, only_b = 0;
+  // +1 for b, -1 for a, 0 when the discordant points do not favour one beyond chance:
+  // |only_b - only_a| <= 3 sqrt(only_a + only_b) (McNemar's test for paired counts, at 3 sigma).
+  int preference() const;
+};
+
+// A reference sample indexed for "is a point within the tolerance" queries (voxels of that edge).
+class ScanAgreement {
+ public:
+  ScanAgreement(const ScanSample& reference, double tolerance);
+
+  // The points of `query` (in its own frame) that land within the tolerance of a reference point
+  // when moved into the reference's frame by T_reference_query.
+  std::size_t count(const ScanSample& query, const Eigen::Isometry3d& T_reference_query) const;
+  // The same per point of `query`: whether it agrees.
+  std::vector<bool> agreeing(const ScanSample& query, const Eigen::Isometry3d& T_reference_query) const;
+  // The points of `query` for pose a against pose b (both T_reference_query).
+  ScanVote vote(const ScanSample& query, const Eigen::Isometry3d& T_reference_query_a,
+                const Eigen::Isometry3d& T_reference_query_b) const;
+
+ private:
+  float tolerance_;
+  VoxelIndex index_;                    // voxel -> slot
+  std::vector<std::uint32_t> begin_;    // slot -> its points: points_[begin_[slot] .. begin_[slot + 1])
+  std::vector<Eigen::Vector3f> points_;  // the reference, grouped by voxel
+};
+
+}  // namespace rgbl

@@ -1,0 +1,107 @@
+#include "rgbl/geometry/scan_agreement.hpp"
+
+#include "rgbl/core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rgbl {
+
+void ScanSampleOptions::validate() const {
+  require(stride >= 1, "scan_sample.stride", ">= 1");
+  require(std::isfinite(min_range) && min_range >= 0.0, "scan_sample.min_range", ">= 0 m");
+  require(std::isfinite(max_range) && max_range > min_range, "scan_sample.max_range", "finite and > min_range");
+  require(std::isfinite(tolerance) && tolerance > 0.0, "scan_sample.tolerance", "> 0 m");
+}
+
+ScanSample sample_scan(PointCloudView scan, const Eigen::Isometry3d& T_cam_lidar, const ScanSampleOptions& options) {
+  ScanSample sample;
+  const auto min2 = static_cast<float>(options.min_range * options.min_range);
+  const auto max2 = static_cast<float>(options.max_range * options.max_range);
+  const Eigen::Isometry3f T = T_cam_lidar.cast<float>();
+  sample.points.reserve(scan.size() / options.stride + 1);
+  for (std::size_t i = 0; i < scan.size(); i += options.stride) {
+    const Eigen::Vector3f p(scan[i].x, scan[i].y, scan[i].z);
+    const float r2 = p.squaredNorm();
+    if (!(r2 >= min2 && r2 <= max2)) continue;  // also drops NaN
+    sample.points.push_back(T * p);
+  }
+  return sample;
+}
+
+ScanAgreement::ScanAgreement(const ScanSample& reference, double tolerance)
+    : tolerance_(static_cast<float>(tolerance)) {
+  // Group the points by voxel in two passes: count per voxel, then place.
+  const float inv = 1.0F / tolerance_;
+  std::vector<std::uint32_t> slot_of(reference.points.size());
+  std::vector<std::uint32_t> counts;
+  index_.reserve(reference.points.size());
+  for (std::size_t i = 0; i < reference.points.size(); ++i) {
+    const auto [slot, added] =
+        index_.emplace(voxel_of(reference.points[i], inv), static_cast<std::uint32_t>(counts.size()));
+    if (added) counts.push_back(0);
+    ++counts[slot];
+    slot_of[i] = slot;
+  }
+  begin_.assign(counts.size() + 1, 0);
+  for (std::size_t s = 0; s < counts.size(); ++s) begin_[s + 1] = begin_[s] + counts[s];
+  std::vector<std::uint32_t> next(begin_.begin(), begin_.end() - 1);
+  points_.resize(reference.points.size());
+  for (std::size_t i = 0; i < reference.points.size(); ++i) points_[next[slot_of[i]]++] = reference.points[i];
+}
+
+std::size_t ScanAgreement::count(const ScanSample& query, const Eigen::Isometry3d& T_reference_query) const {
+  const std::vector<bool> flags = agreeing(query, T_reference_query);
+  return static_cast<std::size_t>(std::count(flags.begin(), flags.end(), true));
+}
+
+std::vector<bool> ScanAgreement::agreeing(const ScanSample& query, const Eigen::Isometry3d& T_reference_query) const {
+  const Eigen::Isometry3f T = T_reference_query.cast<float>();
+  const float inv = 1.0F / tolerance_;
+  const float tolerance2 = tolerance_ * tolerance_;
+  const auto near_in = [&](const VoxelKey& key, const Eigen::Vector3f& p) {
+    const std::uint32_t slot = index_.find(key);
+    if (slot == VoxelIndex::npos) return false;
+    for (std::uint32_t j = begin_[slot]; j < begin_[slot + 1]; ++j) {
+      if ((points_[j] - p).squaredNorm() <= tolerance2) return true;
+    }
+    return false;
+  };
+  std::vector<bool> flags(query.points.size(), false);
+  for (std::size_t i = 0; i < query.points.size(); ++i) {
+    const Eigen::Vector3f p = T * query.points[i];
+    const VoxelKey key = voxel_of(p, inv);
+    bool found = near_in(key, p);  // the point's own voxel holds most matches: first
+    for (int dx = -1; dx <= 1 && !found; ++dx) {
+      for (int dy = -1; dy <= 1 && !found; ++dy) {
+        for (int dz = -1; dz <= 1 && !found; ++dz) {
+          if (dx != 0 || dy != 0 || dz != 0) found = near_in({key.x + dx, key.y + dy, key.z + dz}, p);
+        }
+      }
+    }
+    flags[i] = found;
+  }
+  return flags;
+}
+
+ScanVote ScanAgreement::vote(const ScanSample& query, const Eigen::Isometry3d& T_reference_query_a,
+                             const Eigen::Isometry3d& T_reference_query_b) const {
+  const std::vector<bool> a = agreeing(query, T_reference_query_a);
+  const std::vector<bool> b = agreeing(query, T_reference_query_b);
+  ScanVote vote;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    vote.only_a += a[i] && !b[i] ? 1 : 0;
+    vote.only_b += b[i] && !a[i] ? 1 : 0;
+  }
+  return vote;
+}
+
+int ScanVote::preference() const {
+  const double difference = static_cast<double>(only_b) - static_cast<double>(only_a);
+  const double spread = 3.0 * std::sqrt(static_cast<double>(only_a + only_b));
+  if (difference > spread) return 1;
+  if (-difference > spread) return -1;
+  return 0;
+}
+
+}  // namespace rgbl
