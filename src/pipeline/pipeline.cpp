@@ -248,7 +248,7 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
     builders.reserve(ahead_max);
     for (std::size_t b = 0; b < ahead_max; ++b) {
       builders.emplace_back(context_.calibration, system_.depth_noise, make_depth_source(),
-                            make_orb_extractor(orb_, pool), pool);
+                            make_orb_extractor(orb_, pool), pool, system_.tracker.scan_sample);
     }
     std::size_t started = 0;
     bool loaded_all = false;

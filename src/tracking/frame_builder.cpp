@@ -9,9 +9,10 @@ namespace rgbl {
 
 FrameBuilder::FrameBuilder(const CameraCalibration& calibration, const DepthNoiseModel& noise,
                            std::unique_ptr<DepthSource> depth, FeatureExtractor extractor,
-                           std::shared_ptr<TaskPool> pool)
+                           std::shared_ptr<TaskPool> pool, const ScanSampleOptions& scan_sample)
     : calibration_(calibration), noise_(noise), depth_(std::move(depth)), extractor_(std::move(extractor)),
-      pool_(std::move(pool)) {
+      pool_(std::move(pool)), scan_sample_(scan_sample) {
+  scan_sample_.validate();
   if (!depth_) throw ConfigError("depth", "a depth source");
   if (!extractor_) throw ConfigError("extractor", "a feature extractor");
 }
@@ -26,6 +27,9 @@ PreparedFrame FrameBuilder::build(const SensorFrame& sensor) {
   double prepare_ms = 0.0;
   const auto prepare = [&] {
     Stopwatch t;
+    if (!sensor.scan.empty()) {
+      frame.scan = std::make_shared<const ScanSample>(sample_scan(sensor.scan, calibration_.T_cam_lidar, scan_sample_));
+    }
     depth_->prepare(sensor);
     prepare_ms = t.elapsed_ms();
   };

@@ -2,6 +2,7 @@
 
 #include "matching.hpp"
 #include "rgbl/core/log.hpp"
+#include "rgbl/geometry/voxel_index.hpp"
 
 #include <Eigen/Geometry>
 
@@ -18,11 +19,6 @@
 
 namespace rgbl {
 
-namespace {
-
-// Marks the points (camera frame, y down) on the dominant ground plane: a plane below the camera by at
-// least ground_min_height whose normal is within ground_max_tilt_deg of the camera's vertical, fitted by
-// a fixed-seed RANSAC. Empty when no such plane holds ground_min_points points.
 std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const TrackerOptions& options) {
   std::vector<bool> ground;
   std::vector<int> below;
@@ -72,7 +68,20 @@ std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const T
   return ground;
 }
 
-}  // namespace
+ScanSample scan_evidence(const ScanSample& sample, const TrackerOptions& options) {
+  std::vector<Eigen::Vector3d> points(sample.points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) points[i] = sample.points[i].cast<double>();
+  const std::vector<bool> ground = ground_points(points, options);
+  ScanSample evidence;
+  VoxelIndex taken;
+  taken.reserve(sample.points.size());
+  const auto inv = static_cast<float>(1.0 / options.scan_sample.tolerance);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!ground.empty() && ground[i]) continue;
+    if (taken.emplace(voxel_of(sample.points[i], inv), 0).second) evidence.points.push_back(sample.points[i]);
+  }
+  return evidence;
+}
 
 std::vector<bool> ground_keypoints(const PinholeCamera& camera, const Frame& frame, const TrackerOptions& options) {
   std::vector<Eigen::Vector3d> points;

@@ -3,6 +3,7 @@
 #include "matching.hpp"
 #include "rgbl/backend/pose_optimizer.hpp"
 #include "rgbl/core/log.hpp"
+#include "rgbl/geometry/scan_agreement.hpp"
 #include "rgbl/geometry/se3.hpp"
 #include "rgbl/map/landmark_view.hpp"
 #include "rgbl/tracking/frame_motion.hpp"
@@ -180,6 +181,13 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
       for (std::size_t i = 0; i < ground.size(); ++i) count += ground[i] && f.landmarks[i].valid() ? 1 : 0;
       return count;
     };
+    // The last frame's scan, indexed once for the LiDAR's say between starts (see scan_arbitration).
+    std::optional<ScanAgreement> last_scan;
+    ScanSample evidence;
+    if (!others.empty() && options_.scan_arbitration && last_frame_ && last_frame_->scan && frame.scan) {
+      last_scan.emplace(*last_frame_->scan, options_.scan_sample.tolerance);
+      evidence = scan_evidence(*frame.scan, options_);
+    }
     for (OtherStart& other_start : others) {
       // starts converged to different poses: the local map decides. A rival motion's views count
       // only if it wins, so that a start that loses leaves the map's statistics as they were.
@@ -197,9 +205,21 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
       // motions in view (the scene and a car) are not: each is a consensus of its own.
       const bool apart = !check_step(frame.T_cam_world, other_start.frame.T_cam_world, 0.0, dt, options_).plausible;
       if (apart && !other_start.rival) h.weak = true;
-      // A rival within a step's tolerance of the first start is the same motion found twice.
-      const bool better = (apart || !other_start.rival) &&
-                          std::pair(other_road, other.inliers) > std::pair(road, first.local.inliers);
+      // The LiDAR first, where it is decisive (and the start it picks holds on the local map); else
+      // the road, then the inliers. A rival within a step's tolerance of the first start is the same
+      // motion found twice.
+      int lidar = 0;
+      if (last_scan) {
+        const ScanVote vote =
+            last_scan->vote(evidence, last_frame_->T_cam_world * frame.T_cam_world.inverse(),
+                            last_frame_->T_cam_world * other_start.frame.T_cam_world.inverse());
+        lidar = vote.preference();
+        logger()->debug("frame {}: of {} LiDAR returns off the road, {} land on the last frame's scan only from the "
+                        "first start, {} only from the other", frame.index, evidence.points.size(), vote.only_a,
+                        vote.only_b);
+      }
+      const bool by_images = std::pair(other_road, other.inliers) > std::pair(road, first.local.inliers);
+      const bool better = (apart || !other_start.rival) && (lidar > 0 ? other.ok : lidar == 0 && by_images);
       if (better) {
         frame = std::move(other_start.frame);
         first.local = other;

@@ -234,3 +234,26 @@ TEST_CASE("frame motion: ground and moving-object options are validated with the
   options.moving_label_radius = -1.0;
   CHECK_THROWS_WITH(options.validate(), Catch::Matchers::Contains("tracker.moving_label_radius"));
 }
+
+TEST_CASE("scan evidence: the road's returns leave, the rest counts once per voxel") {
+  // Camera frame (y down): a road 1.65 m below the camera sampled every 10 cm, and a pole 5 m to the
+  // right sampled every 1 cm (a near object returns far more points per square metre than a far one).
+  rgbl::ScanSample sample;
+  for (double x = -8.0; x <= 8.0; x += 0.1) {
+    for (double z = 3.0; z <= 30.0; z += 0.1) sample.points.emplace_back(x, 1.65, z);
+  }
+  const std::size_t road = sample.points.size();
+  for (double y = -3.0; y < 1.0; y += 0.01) sample.points.emplace_back(5.0, y, 10.0);
+  const rgbl::TrackerOptions options;  // scan_sample.tolerance 0.3 m
+  const rgbl::ScanSample evidence = rgbl::scan_evidence(sample, options);
+  // no road return is left; the pole's 400 returns become one per 0.3 m voxel it crosses (4 m / 0.3)
+  for (const Eigen::Vector3f& p : evidence.points) CHECK(p.x() == Approx(5.0F));
+  CHECK(evidence.points.size() >= 13);
+  CHECK(evidence.points.size() <= 15);
+  CHECK(road > 40000);
+
+  // without a ground plane (too few points below the camera) nothing is taken for road
+  rgbl::ScanSample wall;
+  for (double y = -3.0; y < 0.5; y += 0.01) wall.points.emplace_back(0.0, y, 10.0);
+  CHECK(rgbl::scan_evidence(wall, options).points.size() >= 11);
+}

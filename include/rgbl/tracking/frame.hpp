@@ -5,6 +5,7 @@
 #include "rgbl/features/orb.hpp"
 #include "rgbl/core/task_pool.hpp"
 #include "rgbl/features/types.hpp"
+#include "rgbl/geometry/scan_agreement.hpp"
 #include "rgbl/map/map.hpp"
 
 #include <Eigen/Geometry>
@@ -43,6 +44,9 @@ struct Frame {
   // are neither matched nor made landmarks.
   std::vector<bool> moving;
   Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();
+  // A subsample of the frame's LiDAR scan in its camera frame (null without a scan): a second
+  // opinion on poses that the images leave ambiguous. Shared, so copies of the frame are cheap.
+  std::shared_ptr<const ScanSample> scan;
   FeatureGrid grid;  // radius queries over keypoints; rebuild after changing them
 
   std::size_t size() const { return keypoints.size(); }

@@ -30,8 +30,10 @@ class FrameBuilder {
  public:
   // With a pool of more than one thread the depth source prepares the frame while features are
   // extracted (and the extractor may use the pool too, see make_orb_extractor).
+  // scan_sample: what the frame keeps of its LiDAR scan (Frame::scan).
   FrameBuilder(const CameraCalibration& calibration, const DepthNoiseModel& noise, std::unique_ptr<DepthSource> depth,
-               FeatureExtractor extractor, std::shared_ptr<TaskPool> pool = nullptr);
+               FeatureExtractor extractor, std::shared_ptr<TaskPool> pool = nullptr,
+               const ScanSampleOptions& scan_sample = {});
 
   // Throws what the depth source throws on input it cannot use (e.g. no right image for stereo).
   PreparedFrame build(const SensorFrame& sensor);
@@ -44,6 +46,7 @@ class FrameBuilder {
   std::unique_ptr<DepthSource> depth_;
   FeatureExtractor extractor_;
   std::shared_ptr<TaskPool> pool_;
+  ScanSampleOptions scan_sample_;
   cv::Mat gray_;
   std::vector<Eigen::Vector2f> pixels_;
   std::vector<KeypointDepth> depths_;

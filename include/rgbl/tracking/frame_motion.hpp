@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <optional>
+#include <span>
 #include <vector>
 
 namespace rgbl {
@@ -35,6 +36,17 @@ namespace rgbl {
 inline double depth_tolerance(double z, const TrackerOptions& options) {
   return std::max(options.ransac_min_tolerance, options.ransac_relative_tolerance * z);
 }
+
+// Marks the points (camera frame, y down) on the dominant ground plane: a plane below the camera by at
+// least ground_min_height whose normal is within ground_max_tilt_deg of the camera's vertical, fitted by
+// a fixed-seed RANSAC. Empty when no such plane holds ground_min_points points.
+std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const TrackerOptions& options);
+
+// The returns of a frame's scan sample that can tell two poses of it apart (see scan_arbitration):
+// those off the ground plane (the road looks the same under any motion along it, and its scan rings
+// coincide best at zero motion), one per scan_sample.tolerance voxel (a truck alongside returns a
+// hundred times more points per square metre than a facade across the street).
+ScanSample scan_evidence(const ScanSample& sample, const TrackerOptions& options);
 
 // Per keypoint of `frame`: with depth and on the dominant ground plane (options.ground_*, the plane
 // estimate_frame_motion ranks a consensus by). Empty when no such plane holds ground_min_points.
