@@ -5,11 +5,16 @@
 # difference to a saved baseline. Judge every tracking change on the whole table.
 #
 #   scripts/accuracy.sh [--build DIR] [--out DIR] [--seeds "1 2 3"] [--frames N] [--scenarios "a b"]
-#                       [--baseline FILE] [--save-baseline FILE] [--no-real] [--no-sim] [-- ARGS for rgbl run]
+#                       [--baseline FILE] [--save-baseline FILE] [--no-real] [--no-variants] [--no-sim]
+#                       [-- ARGS for rgbl run]
 #
 # Each scenario runs at its default length (`rgbl demo --scenario list`) unless --frames is given; the
 # plain street runs at every length used (`plain@<frames>-s<seed>`), so each scenario's ATE is compared
 # with the plain street's at the same frame count and seed.
+# Each real drive of at least 30 frames also runs as harder variants of itself: at 3.3 and 1.7 Hz
+# (--step 3, --step 6), with a forward-driving camera's motion blur (60 per mille: 37 px at the side
+# edges), with exposure jumps (+-30 %), and blurred at 3.3 Hz (scripts/degrade.py, which needs Debian's
+# python3-opencv; those rows are skipped without it). The LiDAR and the ground truth stay real.
 # Data: $RGBL_DATA, else ../shared/data next to the repository. Generated scenarios are cached in
 # $RGBL_CACHE (default ~/.cache/rgbl/scenarios), keyed by the simulator's sources, so a rerun after a
 # tracker change only tracks.
@@ -24,6 +29,7 @@ scenarios=""
 baseline="$repo/docs/accuracy-baseline.json"
 save=""
 real=1
+variants=1
 sim=1
 extra=()
 while [ $# -gt 0 ]; do
@@ -36,9 +42,10 @@ while [ $# -gt 0 ]; do
     --baseline) baseline="$2"; shift 2 ;;
     --save-baseline) save="$2"; shift 2 ;;
     --no-real) real=0; shift ;;
+    --no-variants) variants=0; shift ;;
     --no-sim) sim=0; shift ;;
     --) shift; extra=("$@"); break ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
     *) echo "accuracy.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -68,15 +75,46 @@ track() {  # name, then rgbl arguments
 if [ "$real" = 1 ]; then
   if [ -d "$data/kitti" ]; then
     echo "real excerpts in $data/kitti:"
+    drives=()   # "name folder"
     for seq in "$data"/kitti/odometry/sequences/*/; do
-      [ -d "$seq" ] && track "real-odometry-$(basename "$seq")" run "$seq" "${extra[@]}"
+      [ -d "$seq" ] && drives+=("real-odometry-$(basename "$seq") ${seq%/}")
     done
     for drive in "$data"/kitti/raw*/*/*_sync/; do
       [ -d "$drive" ] || continue
       set_name="$(basename "$(dirname "$(dirname "$drive")")")"   # raw or raw_extended
       id="$(basename "$drive" | sed -E 's/.*_drive_([0-9]+)_sync/\1/')"
-      track "real-$set_name-$id" run "$drive" "${extra[@]}"
+      drives+=("real-$set_name-$id ${drive%/}")
     done
+    for d in "${drives[@]}"; do
+      read -r name folder <<< "$d"
+      track "$name" run "$folder" "${extra[@]}"
+    done
+    if [ "$variants" = 1 ]; then
+      have_cv=1
+      /usr/bin/python3 -c "import cv2" 2> /dev/null || have_cv=0
+      [ "$have_cv" = 1 ] || echo "  (blurred and exposure variants skipped: scripts/degrade.py needs python3-opencv)"
+      degrade_key="$(sha1sum < "$repo/scripts/degrade.py" | cut -c1-12)"
+      for d in "${drives[@]}"; do
+        read -r name folder <<< "$d"
+        [ "$(ls "$folder"/image_0/ "$folder"/image_00/data/ 2> /dev/null | grep -c '\.png$')" -ge 30 ] || continue
+        track "$name-step3" run "$folder" --step 3 "${extra[@]}"
+        track "$name-step6" run "$folder" --step 6 "${extra[@]}"
+        [ "$have_cv" = 1 ] || continue
+        for v in "blur60 --blur 60" "gain30 --gain 0.3"; do
+          read -r vname vargs <<< "$v"
+          # the copy keeps the layout: sequences/NN (poses two levels up) or <date>/<drive> (calibration one up)
+          root="$cache/degraded/$name-$vname-$degrade_key"
+          copy="$root/$(basename "$(dirname "$folder")")/$(basename "$folder")"
+          if [ ! -f "$root/.complete" ]; then
+            rm -rf "$root"
+            "$repo/scripts/degrade.py" "$folder" "$copy" $vargs >> "$log" 2>&1 && touch "$root/.complete" ||
+              { printf '  %-28s degrading FAILED\n' "$name-$vname"; continue; }
+          fi
+          track "$name-$vname" run "$copy" "${extra[@]}"
+          [ "$vname" = blur60 ] && track "$name-$vname-step3" run "$copy" --step 3 "${extra[@]}"
+        done
+      done
+    fi
   else
     echo "skipped: no data ($data/kitti absent; set RGBL_DATA)"
   fi
