@@ -101,6 +101,10 @@ class Tracker {
   FirstHypothesis first_hypothesis(Frame frame, const Prediction& prediction, ViewLog& views) const;
   // Relocalisation against the whole map, independent of any prediction, confirmed on the local map.
   Hypothesis relocalisation_hypothesis(Frame frame, KeyframeId reference, ViewLog& views) const;
+  // The LiDAR's say between two poses of `frame` (see TrackerOptions::scan_arbitration): +1 for b, -1
+  // for a, 0 when it is not decisive or either scan is missing. a and b name them in the log.
+  int lidar_preference(const Frame& frame, const Eigen::Isometry3d& T_a_world, const Eigen::Isometry3d& T_b_world,
+                       const char* a, const char* b) const;
   // A step beyond a vehicle's reach on weak evidence: the local map searched from the prediction
   // instead, else the frame placed at the prediction.
   Hypothesis step_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const;
