@@ -120,12 +120,13 @@ struct TrackerOptions {
   double max_acceleration = 10.0;          // m/s^2, 1 g: more than a car brakes
   double step_tolerance_rotation_deg = 3.0;
   int min_jump_inliers = 50;
-  // Where the images leave two poses of a frame standing (two starts against the reference keyframe),
-  // the LiDAR decides first when it can: the pose under which more of the frame's scan lands on the
-  // last frame's wins, if the two counts differ beyond chance (scan_preference). Images can agree
-  // with a wrong pose (a car ahead at the ego speed, road paint repeating at the step length, motion
-  // blur that looks alike at zero motion); the static world's shape does not. Else, and without
-  // scans, the road re-finds and then the inliers decide, as before.
+  // Where the images leave two starts of a frame standing further apart than a step's tolerance, the
+  // LiDAR decides first when it can: the frame's returns off the road that land on the last frame's
+  // scan under one start only vote for it, and a start wins when the votes differ beyond chance
+  // (ScanVote::preference) and it holds on the local map. Images can agree with a wrong pose (a car
+  // ahead at the ego speed, road paint repeating at the step length, motion blur that looks alike at
+  // zero motion); the static world's shape does not. Else, and without scans, the road re-finds and
+  // then the inliers decide, as before.
   bool scan_arbitration = true;
   ScanSampleOptions scan_sample;          // what a frame keeps of its scan (Frame::scan)
   bool temporary_points = true;         // last-frame depth points without landmark join the motion model
