@@ -207,6 +207,8 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
                               : 0;
       const bool by_images = std::pair(other_road, other.inliers) > std::pair(road, first.local.inliers);
       const bool better = (apart || !other_start.rival) && (lidar > 0 ? other.ok : lidar == 0 && by_images);
+      // the scans overrule the images: the sensors contradict each other, the frame is never silently ok
+      if (lidar != 0 && (lidar > 0) != by_images) h.weak = true;
       if (better) {
         frame = std::move(other_start.frame);
         first.local = other;
