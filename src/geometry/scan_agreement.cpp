@@ -2,7 +2,6 @@
 
 #include "rgbl/core/error.hpp"
 
-#include <algorithm>
 #include <cmath>
 
 namespace rgbl {
@@ -31,8 +30,9 @@ ScanSample sample_scan(PointCloudView scan, const Eigen::Isometry3d& T_cam_lidar
 
 ScanAgreement::ScanAgreement(const ScanSample& reference, double tolerance)
     : tolerance_(static_cast<float>(tolerance)) {
-  // Group the points by voxel in two passes: count per voxel, then place.
-  const float inv = 1.0F / tolerance_;
+  // Voxels of twice the tolerance: every point within the tolerance of a query lies in the 2x2x2 block
+  // around it. Points are grouped by voxel in two passes: count per voxel, then place.
+  const float inv = 0.5F / tolerance_;
   std::vector<std::uint32_t> slot_of(reference.points.size());
   std::vector<std::uint32_t> counts;
   index_.reserve(reference.points.size());
@@ -50,37 +50,35 @@ ScanAgreement::ScanAgreement(const ScanSample& reference, double tolerance)
   for (std::size_t i = 0; i < reference.points.size(); ++i) points_[next[slot_of[i]]++] = reference.points[i];
 }
 
+bool ScanAgreement::lands(const Eigen::Vector3f& p) const {
+  // the block's lowest voxel: p - tolerance lies in it on every axis, p + tolerance in the one above
+  const VoxelKey low = voxel_of(Eigen::Vector3f(p.array() - tolerance_), 0.5F / tolerance_);
+  const float tolerance2 = tolerance_ * tolerance_;
+  for (int dx = 0; dx <= 1; ++dx) {
+    for (int dy = 0; dy <= 1; ++dy) {
+      for (int dz = 0; dz <= 1; ++dz) {
+        const std::uint32_t slot = index_.find({low.x + dx, low.y + dy, low.z + dz});
+        if (slot == VoxelIndex::npos) continue;
+        for (std::uint32_t j = begin_[slot]; j < begin_[slot + 1]; ++j) {
+          if ((points_[j] - p).squaredNorm() <= tolerance2) return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
 std::size_t ScanAgreement::count(const ScanSample& query, const Eigen::Isometry3d& T_reference_query) const {
-  const std::vector<bool> flags = agreeing(query, T_reference_query);
-  return static_cast<std::size_t>(std::count(flags.begin(), flags.end(), true));
+  const Eigen::Isometry3f T = T_reference_query.cast<float>();
+  std::size_t agreeing = 0;
+  for (const Eigen::Vector3f& q : query.points) agreeing += lands(T * q) ? 1 : 0;
+  return agreeing;
 }
 
 std::vector<bool> ScanAgreement::agreeing(const ScanSample& query, const Eigen::Isometry3d& T_reference_query) const {
   const Eigen::Isometry3f T = T_reference_query.cast<float>();
-  const float inv = 1.0F / tolerance_;
-  const float tolerance2 = tolerance_ * tolerance_;
-  const auto near_in = [&](const VoxelKey& key, const Eigen::Vector3f& p) {
-    const std::uint32_t slot = index_.find(key);
-    if (slot == VoxelIndex::npos) return false;
-    for (std::uint32_t j = begin_[slot]; j < begin_[slot + 1]; ++j) {
-      if ((points_[j] - p).squaredNorm() <= tolerance2) return true;
-    }
-    return false;
-  };
-  std::vector<bool> flags(query.points.size(), false);
-  for (std::size_t i = 0; i < query.points.size(); ++i) {
-    const Eigen::Vector3f p = T * query.points[i];
-    const VoxelKey key = voxel_of(p, inv);
-    bool found = near_in(key, p);  // the point's own voxel holds most matches: first
-    for (int dx = -1; dx <= 1 && !found; ++dx) {
-      for (int dy = -1; dy <= 1 && !found; ++dy) {
-        for (int dz = -1; dz <= 1 && !found; ++dz) {
-          if (dx != 0 || dy != 0 || dz != 0) found = near_in({key.x + dx, key.y + dy, key.z + dz}, p);
-        }
-      }
-    }
-    flags[i] = found;
-  }
+  std::vector<bool> flags(query.points.size());
+  for (std::size_t i = 0; i < query.points.size(); ++i) flags[i] = lands(T * query.points[i]);
   return flags;
 }
 

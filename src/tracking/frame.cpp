@@ -19,6 +19,8 @@ FeatureExtractor make_orb_extractor(const OrbOptions& options, std::shared_ptr<T
 
 void TrackerOptions::validate() const {
   scan_sample.validate();
+  require(std::isfinite(lidar_start_max_speed) && lidar_start_max_speed >= 0.0, "tracker.lidar_start_max_speed",
+          ">= 0 m/s (0 = off)");
   require(min_initial_depth_points >= 10, "tracker.min_initial_depth_points", ">= 10");
   require(motion_radius > 0.0, "tracker.motion_radius", "> 0");
   require(local_map_radius > 0.0, "tracker.local_map_radius", "> 0");

@@ -14,29 +14,34 @@
 #include <random>
 #include <span>
 #include <iterator>
+#include <optional>
 #include <tuple>
 #include <vector>
 
 namespace rgbl {
 
-std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const TrackerOptions& options) {
-  std::vector<bool> ground;
-  std::vector<int> below;
-  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
-    if (points[static_cast<std::size_t>(i)].y() >= options.ground_min_height) below.push_back(i);
-  }
-  if (static_cast<int>(below.size()) < options.ground_min_points) return ground;
+namespace {
+
+// A depth error lies along the viewing ray; the road is seen at a grazing angle, so only the ray's
+// component along the plane normal moves a point off the plane (its depth error times n.p/|p|).
+double ground_tolerance(const Eigen::Vector3d& p, const Eigen::Vector3d& n, const TrackerOptions& options) {
+  return std::max(options.ground_tolerance, options.ransac_relative_tolerance * p.z() * std::abs(n.dot(p)) / p.norm());
+}
+
+struct GroundPlane {
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();  // pointing down, as the camera's y
+  double d = 0.0;                               // the camera's height above it
+};
+
+// The fixed-seed RANSAC of ground_points over the candidate points `below`.
+std::optional<GroundPlane> fit_ground(std::span<const Eigen::Vector3d> points, std::span<const int> below,
+                                      const TrackerOptions& options) {
+  if (static_cast<int>(below.size()) < options.ground_min_points) return std::nullopt;
   const double cos_tilt = std::cos(options.ground_max_tilt_deg * std::numbers::pi / 180.0);
-  // A depth error lies along the viewing ray; the road is seen at a grazing angle, so only the ray's
-  // component along the plane normal moves a point off the plane (its depth error times n.p/|p|).
-  auto tolerance = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
-    return std::max(options.ground_tolerance, options.ransac_relative_tolerance * p.z() * std::abs(n.dot(p)) / p.norm());
-  };
   std::mt19937 rng(11);  // fixed seed: deterministic
   std::uniform_int_distribution<std::size_t> pick(0, below.size() - 1);
   int best_count = 0;
-  Eigen::Vector3d best_n = Eigen::Vector3d::Zero();
-  double best_d = 0.0;
+  GroundPlane best;
   for (int it = 0; it < options.ground_iterations; ++it) {
     const Eigen::Vector3d& a = points[static_cast<std::size_t>(below[pick(rng)])];
     const Eigen::Vector3d& b = points[static_cast<std::size_t>(below[pick(rng)])];
@@ -44,34 +49,62 @@ std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const T
     Eigen::Vector3d n = (b - a).cross(c - a);
     if (n.norm() < 1e-6) continue;
     n.normalize();
-    if (n.y() < 0.0) n = -n;  // pointing down, as the camera's y
+    if (n.y() < 0.0) n = -n;
     if (n.y() < cos_tilt) continue;
-    const double d = n.dot(a);  // the camera's height above the plane
+    const double d = n.dot(a);
     if (d < options.ground_min_height) continue;
     int count = 0;
     for (const int i : below) {
       const Eigen::Vector3d& p = points[static_cast<std::size_t>(i)];
-      count += std::abs(n.dot(p) - d) < tolerance(p, n) ? 1 : 0;
+      count += std::abs(n.dot(p) - d) < ground_tolerance(p, n, options) ? 1 : 0;
     }
     if (count > best_count) {
       best_count = count;
-      best_n = n;
-      best_d = d;
+      best = {n, d};
     }
   }
-  if (best_count < options.ground_min_points) return ground;
-  ground.assign(points.size(), false);
+  if (best_count < options.ground_min_points) return std::nullopt;
+  return best;
+}
+
+std::vector<int> below_camera(std::span<const Eigen::Vector3d> points, const TrackerOptions& options) {
+  std::vector<int> below;
+  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+    if (points[static_cast<std::size_t>(i)].y() >= options.ground_min_height) below.push_back(i);
+  }
+  return below;
+}
+
+// Flags the points of `below` on the plane.
+std::vector<bool> on_ground(std::span<const Eigen::Vector3d> points, std::span<const int> below,
+                            const GroundPlane& plane, const TrackerOptions& options) {
+  std::vector<bool> ground(points.size(), false);
   for (const int i : below) {
     const Eigen::Vector3d& p = points[static_cast<std::size_t>(i)];
-    ground[static_cast<std::size_t>(i)] = std::abs(best_n.dot(p) - best_d) < tolerance(p, best_n);
+    ground[static_cast<std::size_t>(i)] = std::abs(plane.n.dot(p) - plane.d) < ground_tolerance(p, plane.n, options);
   }
   return ground;
+}
+
+}  // namespace
+
+std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const TrackerOptions& options) {
+  const std::vector<int> below = below_camera(points, options);
+  const std::optional<GroundPlane> plane = fit_ground(points, below, options);
+  return plane ? on_ground(points, below, *plane, options) : std::vector<bool>{};
 }
 
 ScanSample scan_evidence(const ScanSample& sample, const TrackerOptions& options) {
   std::vector<Eigen::Vector3d> points(sample.points.size());
   for (std::size_t i = 0; i < points.size(); ++i) points[i] = sample.points[i].cast<double>();
-  const std::vector<bool> ground = ground_points(points, options);
+  // The plane is fitted on at most 2000 of the returns below the camera (a scan holds ten times more
+  // than the road needs), and every one is then judged against it.
+  const std::vector<int> below = below_camera(points, options);
+  std::vector<int> fit_on;
+  const std::size_t stride = below.size() / 2000 + 1;
+  for (std::size_t k = 0; k < below.size(); k += stride) fit_on.push_back(below[k]);
+  const std::optional<GroundPlane> plane = fit_ground(points, fit_on, options);
+  const std::vector<bool> ground = plane ? on_ground(points, below, *plane, options) : std::vector<bool>{};
   ScanSample evidence;
   VoxelIndex taken;
   taken.reserve(sample.points.size());

@@ -43,7 +43,7 @@ struct ScanVote {
   int preference() const;
 };
 
-// A reference sample indexed for "is a point within the tolerance" queries (voxels of that edge).
+// A reference sample indexed for "is a point within the tolerance" queries (voxels of twice that edge).
 class ScanAgreement {
  public:
   ScanAgreement(const ScanSample& reference, double tolerance);
@@ -58,6 +58,9 @@ class ScanAgreement {
                 const Eigen::Isometry3d& T_reference_query_b) const;
 
  private:
+  // Whether p (in the reference's frame) lies within the tolerance of a reference point.
+  bool lands(const Eigen::Vector3f& p) const;
+
   float tolerance_;
   VoxelIndex index_;                    // voxel -> slot
   std::vector<std::uint32_t> begin_;    // slot -> its points: points_[begin_[slot] .. begin_[slot + 1])

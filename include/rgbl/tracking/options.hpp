@@ -129,6 +129,12 @@ struct TrackerOptions {
   // then the inliers decide, as before.
   bool scan_arbitration = true;
   ScanSampleOptions scan_sample;          // what a frame keeps of its scan (Frame::scan)
+  // ...and where a frame is started against the reference keyframe (no trusted velocity, or the motion
+  // model failed), the LiDAR proposes a start of its own: the step along the last camera's forward axis,
+  // from 1 m back to lidar_start_max_speed times the frame time (every 0.25 m, then every 5 cm), under
+  // which most of those returns land on the last scan, if it beats standing still beyond chance. At 1 Hz
+  // the images may offer no start near the true motion at all. 0 = off.
+  double lidar_start_max_speed = 40.0;    // m/s (144 km/h)
   bool temporary_points = true;         // last-frame depth points without landmark join the motion model
   // Keyframe decision (SPEC section 5)
   int max_frames_between_keyframes = 10;

@@ -101,10 +101,20 @@ class Tracker {
   FirstHypothesis first_hypothesis(Frame frame, const Prediction& prediction, ViewLog& views) const;
   // Relocalisation against the whole map, independent of any prediction, confirmed on the local map.
   Hypothesis relocalisation_hypothesis(Frame frame, KeyframeId reference, ViewLog& views) const;
-  // The LiDAR's say between two poses of `frame` (see TrackerOptions::scan_arbitration): +1 for b, -1
-  // for a, 0 when it is not decisive or either scan is missing. a and b name them in the log.
-  int lidar_preference(const Frame& frame, const Eigen::Isometry3d& T_a_world, const Eigen::Isometry3d& T_b_world,
-                       const char* a, const char* b) const;
+  // What the LiDAR's say reads, built once per frame when first needed: the last frame's scan indexed
+  // and the frame's returns off the road (see TrackerOptions::scan_arbitration).
+  struct LidarView {
+    ScanAgreement last;
+    ScanSample evidence;
+  };
+  // The view, built into `cache` on the first call; nullptr without scan_arbitration or either scan.
+  const LidarView* lidar_view(std::optional<LidarView>& cache, const Frame& frame) const;
+  // The LiDAR's say between two poses of `frame`: +1 for b, -1 for a, 0 when it is not decisive or it
+  // has no view. a and b name them in the log.
+  int lidar_preference(std::optional<LidarView>& cache, const Frame& frame, const Eigen::Isometry3d& T_a_world,
+                       const Eigen::Isometry3d& T_b_world, const char* a, const char* b) const;
+  // The LiDAR's own start for `frame` (see TrackerOptions::lidar_start_max_speed) as T_cur_last.
+  std::optional<Eigen::Isometry3d> lidar_start(std::optional<LidarView>& cache, const Frame& frame) const;
   // A step beyond a vehicle's reach on weak evidence: the local map searched from the prediction
   // instead, else the frame placed at the prediction.
   Hypothesis step_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const;
@@ -132,7 +142,8 @@ class Tracker {
   };
   // Matches the reference keyframe's points by descriptor and optimises the pose. `others` receives the
   // other starts that converged too (the weak consensus first).
-  bool track_reference_keyframe(Frame& frame, std::vector<OtherStart>& others) const;
+  bool track_reference_keyframe(Frame& frame, std::vector<OtherStart>& others,
+                                std::optional<LidarView>& lidar) const;
   // Unmatches keypoints labelled moving and those whose landmark disagrees with frame.T_cam_world (a
   // depth-consensus prediction; see disagrees_with_pose).
   void drop_moving_matches(Frame& frame, double slack = 0.0) const;
