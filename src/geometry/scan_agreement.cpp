@@ -51,6 +51,10 @@ ScanAgreement::ScanAgreement(const ScanSample& reference, double tolerance)
 }
 
 bool ScanAgreement::lands(const Eigen::Vector3f& p) const {
+  // a pose gone wild puts points anywhere: beyond 100 km (or not finite) nothing lands, and the voxel
+  // coordinates below stay within int32
+  constexpr float kFar = 1e5F;
+  if (!(p.cwiseAbs().maxCoeff() < kFar)) return false;
   // the block's lowest voxel: p - tolerance lies in it on every axis, p + tolerance in the one above
   const VoxelKey low = voxel_of(Eigen::Vector3f(p.array() - tolerance_), 0.5F / tolerance_);
   const float tolerance2 = tolerance_ * tolerance_;

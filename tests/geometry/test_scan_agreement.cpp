@@ -64,6 +64,11 @@ TEST_CASE("scan agreement: every point lands on its scene under the true motion,
   // a shift within the tolerance is no evidence either way
   const Eigen::Isometry3d near = truth * Eigen::Translation3d(0.0, 0.0, 0.1);
   CHECK(agreement.vote(after, truth, near).preference() == 0);
+  // a pose gone wild lands nothing (and converts no huge or NaN coordinate to a voxel)
+  CHECK(agreement.count(after, Eigen::Isometry3d(Eigen::Translation3d(1e12, 0.0, 0.0))) == 0);
+  Eigen::Isometry3d nan = truth;
+  nan.translation().x() = std::numeric_limits<double>::quiet_NaN();
+  CHECK(agreement.count(after, nan) == 0);
 }
 
 TEST_CASE("scan vote: McNemar's bound at 3 sigma decides, nothing below it") {
