@@ -281,7 +281,9 @@ std::optional<Eigen::Isometry3d> Tracker::lidar_start(std::optional<LidarView>& 
   const LidarView* view = lidar_view(cache, frame);
   if (view == nullptr) return std::nullopt;
   const double dt = frame.timestamp - last_frame_->timestamp;
-  const double reach = options_.lidar_start_max_speed * (dt > 0.0 && std::isfinite(dt) ? dt : 0.1);
+  // no further than the sample reaches: beyond that the scans share nothing (a gap in the frames)
+  const double reach = std::min(options_.lidar_start_max_speed * (dt > 0.0 && std::isfinite(dt) ? dt : 0.1),
+                                options_.scan_sample.max_range);
   // the search reads at most 1000 of the returns, spread over all of them; the vote then reads all
   ScanSample sparse;
   const std::size_t stride = view->evidence.points.size() / 1000 + 1;
@@ -641,7 +643,7 @@ bool Tracker::track_reference_keyframe(Frame& frame, std::vector<OtherStart>& ot
   };
   auto add_rival = [&](const Frame& matched, std::optional<RivalMotion>& rival) {
     if (!rival) return;
-    OtherStart& other = others.emplace_back(OtherStart{matched, true});
+    OtherStart& other = others.emplace_back(OtherStart{matched, true, false});
     other.frame.moving = std::move(rival->moving);
     start_from(other.frame, rival->T_cur_last);
   };
@@ -660,13 +662,13 @@ bool Tracker::track_reference_keyframe(Frame& frame, std::vector<OtherStart>& ot
                                                     &weak.moving, &rival)) {
         add_rival(frame, rival);
         start_from(weak, *T_weak);
-        others.insert(others.begin(), OtherStart{std::move(weak), false});
+        others.insert(others.begin(), OtherStart{std::move(weak), false, false});
       }
     }
   }
   if (T_lidar) {
     // a rival: its views count only if it wins; no consensus labels its moving points
-    OtherStart& other = others.emplace_back(OtherStart{matched_frame, true});
+    OtherStart& other = others.emplace_back(OtherStart{matched_frame, true, true});
     other.frame.moving.clear();
     start_from(other.frame, *T_lidar);
   }
@@ -679,7 +681,7 @@ bool Tracker::track_reference_keyframe(Frame& frame, std::vector<OtherStart>& ot
     if (optimise(other.frame)) return false;
     // The LiDAR's start stands on the scans, not on these matches: at 1 Hz the brute-force matches
     // against the reference keyframe hold few right ones; the local map searched from its pose decides.
-    if (T_lidar && &other == &others.back()) {
+    if (other.from_lidar) {
       const Eigen::Isometry3d T = *T_lidar * last_frame_->T_cam_world;
       clear_matches(other.frame);
       other.frame.T_cam_world = T;

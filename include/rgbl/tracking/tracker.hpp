@@ -139,6 +139,7 @@ class Tracker {
   struct OtherStart {
     Frame frame;
     bool rival = false;
+    bool from_lidar = false;  // the LiDAR's own start (lidar_start)
   };
   // Matches the reference keyframe's points by descriptor and optimises the pose. `others` receives the
   // other starts that converged too (the weak consensus first).
