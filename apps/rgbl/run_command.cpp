@@ -1,4 +1,4 @@
-// rgbl run <dir> [input options] [--out <dir>] [--threads N] [--threaded] [--no-loop-closing]
+// rgbl run <dir> [input options] [--out <dir>] [--threads N] [--threaded] [--realtime | --rate R] [--no-loop-closing]
 #include "command.hpp"
 #include "input_options.hpp"
 
@@ -21,6 +21,13 @@ Command add_run_command(CLI::App& parent) {
       ->capture_default_str();
   app->add_flag("--threaded", options->threaded,
                 "Local mapping and loop closing in threads of their own (default: inline, bit-for-bit reproducible)");
+  auto* realtime = app->add_flag_callback(
+      "--realtime", [options] { options->playback_rate = 1.0; },
+      "Feed frames at the recording's pace (frame i waits until its timestamp): what threaded mapping has in the car");
+  app->add_option("--rate", options->playback_rate,
+                  "Feed frames at this multiple of the recording's pace (1 = --realtime; default 0: as fast as tracked)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->excludes(realtime);
   app->add_flag("--no-loop-closing", *no_loop_closing,
                 "Do not close loops (default: closed on every keyframe, inline, or in a thread of its own with --threaded)");
   return {app, [options, out_dir, no_loop_closing, app] {

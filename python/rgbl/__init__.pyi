@@ -374,6 +374,7 @@ class PipelineOptions:
     settings: os.PathLike[str]
     threaded: bool
     threads: int
+    playback_rate: float
     loop_closing: bool
     def __init__(self) -> None: ...
 
@@ -414,6 +415,7 @@ class RunResult:
     step: int
     threaded: bool
     threads: int
+    playback_rate: float
     loop_closing: bool
     frames: list[FrameRecord]
     loop_closures: list[LoopClosure]
@@ -447,7 +449,7 @@ class Pipeline:
     def __init__(self, dataset: Union[_Path, PipelineOptions], *, format: str = "auto", camera: int = -1,
                  first: int = 0, frames: int = 0, step: int = 1, depth: str = "lidar",
                  settings: Optional[_Path] = None, threaded: bool = False, loop_closing: bool = True,
-                 threads: int = 0) -> None: ...
+                 threads: int = 0, playback_rate: float = 0.0) -> None: ...
     @property
     def options(self) -> PipelineOptions: ...
     @property

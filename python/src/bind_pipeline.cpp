@@ -23,6 +23,8 @@ void bind_pipeline(py::module_& m) {
       .def_readwrite("settings", &PipelineOptions::settings)
       .def_readwrite("threaded", &PipelineOptions::threaded)
       .def_readwrite("threads", &PipelineOptions::threads, "Frame threads; 0 = the machine's hardware threads.")
+      .def_readwrite("playback_rate", &PipelineOptions::playback_rate,
+                     "Frames fed at this multiple of the recording's pace (1: as recorded); 0 = as fast as tracked.")
       .def_readwrite("loop_closing", &PipelineOptions::loop_closing);
 
   py::class_<FrameRecord>(m, "FrameRecord", "One tracked frame of a run and how long it waited to be loaded.")
@@ -64,6 +66,7 @@ void bind_pipeline(py::module_& m) {
       .def_readonly("step", &RunResult::step)
       .def_readonly("threaded", &RunResult::threaded)
       .def_readonly("threads", &RunResult::threads)
+      .def_readonly("playback_rate", &RunResult::playback_rate)
       .def_readonly("loop_closing", &RunResult::loop_closing)
       .def_readonly("frames", &RunResult::frames, "A FrameRecord per tracked frame (a list copied on each access).")
       .def_property_readonly("trajectory", [](const py::object& self) {
@@ -129,7 +132,7 @@ void bind_pipeline(py::module_& m) {
       .def(py::init([](const std::filesystem::path& dataset, const std::string& format, int camera, std::size_t first,
                        std::size_t frames, std::size_t step, const std::string& depth,
                        const std::optional<std::filesystem::path>& settings, bool threaded, bool loop_closing,
-                       int threads) {
+                       int threads, double playback_rate) {
              PipelineOptions o;
              o.dataset = dataset;
              o.format = parse_dataset_format(format);
@@ -142,15 +145,17 @@ void bind_pipeline(py::module_& m) {
              o.threaded = threaded;
              o.loop_closing = loop_closing;
              o.threads = threads;
+             o.playback_rate = playback_rate;
              const py::gil_scoped_release release;
              return std::make_unique<Pipeline>(o);
            }),
            py::arg("dataset"), py::kw_only(), py::arg("format") = "auto", py::arg("camera") = -1, py::arg("first") = 0,
            py::arg("frames") = 0, py::arg("step") = 1, py::arg("depth") = "lidar",
            py::arg("settings") = py::none(), py::arg("threaded") = false, py::arg("loop_closing") = true,
-           py::arg("threads") = 0,
+           py::arg("threads") = 0, py::arg("playback_rate") = 0.0,
            "The options of `rgbl run <dataset>`: format auto|kitti|kitti-raw|tum, camera 0|2 (-1: 0 when present), "
-           "first frame, frames (0 = all), step, depth source spec, settings YAML, threaded, loop_closing, threads (0: the machine's).")
+           "first frame, frames (0 = all), step, depth source spec, settings YAML, threaded, loop_closing, threads (0: the machine's), "
+           "playback_rate (1: the recording's pace, `--realtime`; 0: as fast as tracked).")
       .def_property_readonly("options", &Pipeline::options)
       .def_property_readonly("sequence", &Pipeline::sequence, py::return_value_policy::reference_internal)
       .def_property_readonly("camera", &Pipeline::camera)

@@ -68,6 +68,9 @@ def test_bad_options_name_the_option(street):
     assert info.value.key == "step"
     with pytest.raises(rgbl.ConfigError, match="sonar"):
         rgbl.Pipeline(street.sequence_dir, depth="sonar")
+    with pytest.raises(rgbl.ConfigError) as info:
+        rgbl.Pipeline(street.sequence_dir, playback_rate=-1.0)
+    assert info.value.key == "playback_rate"
 
 
 def track_from_python(pipeline):

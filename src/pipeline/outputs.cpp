@@ -175,6 +175,7 @@ std::string summary_json(const RunResult& run) {
                           {"closures", l.closures},     {"merges", l.merges},         {"time_ms", number(l.time_ms)}};
   j["threaded_mapping"] = run.threaded;
   j["threads"] = run.threads;
+  j["playback_rate"] = run.playback_rate;
   j["wall_s"] = number(run.wall_s);
   j["stage_ms"] = {{"io_wait", stage(t.io_wait)},
                    {"depth", stage(t.depth)},

@@ -10,7 +10,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <deque>
 #include <mutex>
 #include <shared_mutex>
@@ -92,6 +94,9 @@ void PipelineOptions::validate() const {
   if (depth.empty()) throw ConfigError("depth", "a depth source name (lidar, precomputed:<dir>, stereo, ...)");
   if (threads < 0 || threads > 256) {
     throw ConfigError("threads", fmt::format("0 (the machine's hardware threads) or a count from 1 to 256, not {}", threads));
+  }
+  if (!(playback_rate >= 0.0 && playback_rate <= 1000.0)) {
+    throw ConfigError("playback_rate", fmt::format("0 (as fast as tracked) or a rate up to 1000 (1: the recording's own pace), not {}", playback_rate));
   }
 }
 
@@ -211,6 +216,32 @@ struct InFlight {
   double io_wait_ms = 0.0;
   TaskPool::Task build;  // last: destroyed (waited for) before what it writes to
 };
+
+// Holds each frame back until its timestamp, relative to the first frame's, has passed on the wall
+// clock (scaled by the rate): the pace of the recording. A stop request ends the wait.
+class Pacer {
+ public:
+  explicit Pacer(double rate) : rate_(rate) {}
+  void wait_for(double timestamp, const std::stop_token& stop) {
+    if (rate_ <= 0.0 || !std::isfinite(timestamp)) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (!first_timestamp_) {
+      first_timestamp_ = timestamp;
+      start_ = now;
+      return;
+    }
+    const auto due = start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                  std::chrono::duration<double>((timestamp - *first_timestamp_) / rate_));
+    std::mutex mutex;
+    std::unique_lock lock(mutex);
+    std::condition_variable_any().wait_until(lock, stop, due, [] { return false; });
+  }
+
+ private:
+  double rate_;
+  std::optional<double> first_timestamp_;
+  std::chrono::steady_clock::time_point start_;
+};
 }  // namespace
 
 RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
@@ -221,6 +252,7 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
   std::vector<FrameRecord> records;
   records.reserve(count_);
   Stopwatch wall;
+  Pacer pacer(options_.playback_rate);
   const auto add = [&](FrameRecord record) {
     records.push_back(std::move(record));
     if (progress) progress(records.back(), records.size(), count_);
@@ -233,7 +265,9 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
       const double wait_ms = wait.elapsed_ms();
       if (!input) break;
       FrameRecord record;
-      record.result = system->track(sensor_frame(*input));
+      const SensorFrame sensor = sensor_frame(*input);
+      pacer.wait_for(sensor.timestamp, stop);
+      record.result = system->track(sensor);
       record.io_wait_ms = wait_ms;
       add(std::move(record));
     }
@@ -280,6 +314,7 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
       current->prepared.critical_ms = wait.elapsed_ms();
       if (!stop.stop_requested()) fill();  // the builds overlap the tracking below
       FrameRecord record;
+      pacer.wait_for(current->sensor.timestamp, stop);
       record.result = system->track(current->sensor, std::move(current->prepared));
       record.io_wait_ms = current->io_wait_ms;
       add(std::move(record));
@@ -304,6 +339,7 @@ RunResult Pipeline::collect(System& system, std::vector<FrameRecord> frames, dou
   out.step = options_.step;
   out.threads = threads_;
   out.threaded = system_.threaded_mapping;
+  out.playback_rate = options_.playback_rate;
   out.frames = std::move(frames);
   out.frames_planned = count_;
   out.wall_s = wall_s;

@@ -1,6 +1,7 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/file.hpp"
 #include "rgbl/core/task_pool.hpp"
+#include "rgbl/core/timer.hpp"
 #include "rgbl/pipeline/demo.hpp"
 #include "rgbl/pipeline/describe.hpp"
 #include "rgbl/pipeline/pipeline.hpp"
@@ -431,6 +432,47 @@ TEST_CASE("a stop requested during a run ends it before the next frame, and its 
                                 }()).run();
   CHECK_FALSE(whole.stopped);
   CHECK(nlohmann::json::parse(rgbl::summary_json(whole))["partial"] == false);
+}
+
+TEST_CASE("frames fed at the recording's pace: no frame tracked before its time, the same trajectory, a stop ends the wait") {
+  auto o = options();
+  o.frames = 6;  // 10 Hz: the 6th frame is due 0.5 s after the first (tracking them all takes ~0.1 s)
+  o.threads = 1;
+  const rgbl::RunResult fast = rgbl::Pipeline(o).run();
+  o.playback_rate = 1.0;
+  std::vector<double> started;  // wall time at which each frame's record arrived, from the first
+  rgbl::Stopwatch clock;
+  const rgbl::RunResult paced = rgbl::Pipeline(o).run([&](const rgbl::FrameRecord&, std::size_t, std::size_t) {
+    started.push_back(clock.elapsed_ms() / 1000.0);
+  });
+  REQUIRE(started.size() == 6);
+  // frame i's record comes after its tracking, which started no earlier than i * 0.1 s after frame
+  // 0's, itself after the clock started
+  for (std::size_t i = 1; i < started.size(); ++i) CHECK(started[i] >= 0.1 * static_cast<double>(i));
+  CHECK(paced.wall_s >= 0.5);
+  CHECK(paced.playback_rate == 1.0);
+  CHECK(nlohmann::json::parse(rgbl::summary_json(paced))["playback_rate"] == 1.0);
+  // inline, pacing changes when a frame is tracked, not its pose
+  REQUIRE(paced.trajectory.poses.size() == fast.trajectory.poses.size());
+  for (std::size_t i = 0; i < fast.trajectory.poses.size(); ++i) {
+    CHECK(paced.trajectory.poses[i].matrix() == fast.trajectory.poses[i].matrix());
+  }
+
+  // frames 1000 s apart: a stop request ends the wait at once
+  o.playback_rate = 1e-4;
+  std::stop_source stop;
+  rgbl::Stopwatch stopping;
+  const rgbl::RunResult stopped = rgbl::Pipeline(o).run(
+      [&](const rgbl::FrameRecord&, std::size_t done, std::size_t) {
+        if (done == 1) stop.request_stop();
+      },
+      stop.get_token());
+  CHECK(stopped.stopped);
+  CHECK(stopped.frames.size() == 1);
+  CHECK(stopping.elapsed_ms() < 30000.0);
+
+  o.playback_rate = -1.0;
+  CHECK_THROWS_WITH(rgbl::Pipeline(o), Contains("playback_rate"));
 }
 
 TEST_CASE("run outputs are refused before the run when another process writes into the folder") {

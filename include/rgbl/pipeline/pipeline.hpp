@@ -47,8 +47,13 @@ struct PipelineOptions {
   // pyramid levels on every thread) while this one is tracked. 0 = the machine's hardware threads.
   // The trajectory is the same for every count.
   int threads = 0;
+  // Frames fed at their timestamps' pace times this rate (1: as recorded, as in the car; 0: as fast as
+  // they are tracked). Offline, frames come faster than in the car, so threaded mapping is left behind
+  // more than it would be there; paced, it has a frame's real time to keep up. No effect on
+  // inline runs' trajectories (only on their wall time).
+  double playback_rate = 0.0;
 
-  // Throws ConfigError naming the option (dataset, camera, step, threads).
+  // Throws ConfigError naming the option (dataset, camera, step, threads, playback_rate).
   void validate() const;
 };
 
@@ -94,6 +99,7 @@ struct RunResult {
   std::size_t first = 0, step = 1;
   int threads = 1;  // frame threads (PipelineOptions::threads, resolved)
   bool threaded = false;
+  double playback_rate = 0.0;  // PipelineOptions::playback_rate
   bool loop_closing = false;
 
   std::vector<FrameRecord> frames;
