@@ -33,6 +33,10 @@ int main(int argc, char** argv) {
   app.add_option("--path", path, "camera path")
       ->check(CLI::IsMember({"straight", "curve", "loop", "turn"}))
       ->capture_default_str();
+  int laps = 1;
+  app.add_option("--laps", laps, "laps of --path loop over the frames (its perimeter fitted to them, as `rgbl demo` does)")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
   app.add_option("--sequence", sequence, "sequence number NN")->capture_default_str();
   app.add_option("--width", o.width, "image width (intrinsics: KITTI 04's scaled by width/1226)")->capture_default_str();
   app.add_option("--height", o.height, "image height")->capture_default_str();
@@ -79,6 +83,7 @@ int main(int argc, char** argv) {
       for (const int c : cameras) o.cameras[static_cast<std::size_t>(c)] = true;
     }
     if (no_depth) o.render_depth = false;
+    if (o.path.kind == rgbl::PathKind::loop) rgbl::fit_loop(o, laps);
     if (untextured.size() == 2) o.untextured = rgbl::FrameRange{untextured[0], untextured[1]};
     rgbl::Stopwatch total;
     const rgbl::SyntheticGenerator generator(o);
