@@ -62,6 +62,15 @@ if(NOT step EQUAL 2 OR NOT first EQUAL 10)
   message(FATAL_ERROR "summary.json: step ${step}, first_frame ${first}; expected 2 and 10")
 endif()
 
+# threaded, fed at the recording's pace: frame 9 of the raw drive (10 Hz) is not tracked before 0.9 s
+run_and_check(raw0009_realtime ${data}/raw/2011_09_26/2011_09_26_drive_0009_sync 10 --threaded --realtime)
+file(READ ${WORK_DIR}/raw0009_realtime/summary.json summary)
+string(JSON rate GET "${summary}" playback_rate)
+string(JSON wall GET "${summary}" wall_s)
+if(NOT rate EQUAL 1 OR wall LESS 0.89)
+  message(FATAL_ERROR "summary.json: playback_rate ${rate}, wall_s ${wall}; expected 1 and >= 0.9 s")
+endif()
+
 set(out ${WORK_DIR}/depth04)
 execute_process(COMMAND ${RGBL} -q depth ${data}/odometry/sequences/04 --frames 5 --out ${out}
                 RESULT_VARIABLE rc OUTPUT_VARIABLE stdout ERROR_VARIABLE stderr)
