@@ -6,7 +6,7 @@
 #
 #   scripts/accuracy.sh [--build DIR] [--out DIR] [--seeds "1 2 3"] [--frames N] [--scenarios "a b"]
 #                       [--baseline FILE] [--save-baseline FILE] [--no-real] [--no-variants] [--no-sim]
-#                       [-- ARGS for rgbl run]
+#                       [-- ARGS for rgbl run, e.g. --threaded --realtime]
 #
 # Each scenario runs at its default length (`rgbl demo --scenario list`) unless --frames is given; the
 # plain street runs at every length used (`plain@<frames>-s<seed>`), so each scenario's ATE is compared
