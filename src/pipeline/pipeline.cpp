@@ -232,15 +232,16 @@ class Pacer {
     }
     const auto due = start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                   std::chrono::duration<double>((timestamp - *first_timestamp_) / rate_));
-    std::mutex mutex;
-    std::unique_lock lock(mutex);
-    std::condition_variable_any().wait_until(lock, stop, due, [] { return false; });
+    std::unique_lock lock(mutex_);
+    wake_.wait_until(lock, stop, due, [] { return false; });  // only the time or a stop ends it
   }
 
  private:
   double rate_;
   std::optional<double> first_timestamp_;
   std::chrono::steady_clock::time_point start_;
+  std::mutex mutex_;  // what wake_ needs to wait on; nothing else is shared
+  std::condition_variable_any wake_;
 };
 }  // namespace
 
