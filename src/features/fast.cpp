@@ -159,13 +159,18 @@ __attribute__((target("avx2"))) void row_scores_avx2(const std::uint8_t* row, in
   }
 }
 
-bool cpu_has_avx2() {
-  static const bool has = __builtin_cpu_supports("avx2") != 0;
-  return has;
-}
 #endif
 
 }  // namespace
+
+bool cpu_has_avx2() {
+#if defined(RGBL_HAVE_AVX2_PATH)
+  static const bool has = __builtin_cpu_supports("avx2") != 0;
+  return has;
+#else
+  return false;
+#endif
+}
 
 void fast_score_map(const cv::Mat& img, cv::Rect region, int threshold, std::vector<std::uint8_t>& scores,
                     bool allow_avx2) {

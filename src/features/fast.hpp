@@ -14,6 +14,9 @@ namespace rgbl::detail {
 // FastCorner (rgbl/features/orb.hpp): score = largest threshold t at which the pixel is a corner
 // (p > c + t or p < c - t on a 9-arc).
 
+// Whether this CPU runs the AVX2 paths (compiled per function, chosen at run time).
+bool cpu_has_avx2();
+
 // Score map over `region` (every pixel of it must be >= 3 px inside `img`): score[(y - region.y + 1)
 // * (region.width + 2) + (x - region.x + 1)] is the pixel's FAST score if it is a corner at
 // `threshold`, else 0. The map has a ring of zeros around the region (width + 2 by height + 2).

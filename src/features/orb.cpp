@@ -3,6 +3,7 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/task_pool.hpp"
 
+#include "brief.hpp"
 #include "fast.hpp"
 
 #include <opencv2/imgproc.hpp>
@@ -56,7 +57,6 @@ class SplitMix64 {
   std::uint64_t state_;
 };
 
-inline int round_to_int(float v) { return static_cast<int>(v + (v >= 0.0F ? 0.5F : -0.5F)); }
 
 #if defined(__SSE2__)
 inline __m128i load16(const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
@@ -169,6 +169,13 @@ OrbExtractor::OrbExtractor(const OrbOptions& options) : options_(options) {
   budgets_[static_cast<std::size_t>(levels) - 1] = std::max(0, options_.num_features - assigned);
 
   pattern_ = make_brief_pattern(options_.patch_size);
+  pattern_soa_.resize(pattern_.size() * 4);
+  for (std::size_t i = 0, n = pattern_.size(); i < n; ++i) {
+    pattern_soa_[i] = pattern_[i].x1;
+    pattern_soa_[n + i] = pattern_[i].y1;
+    pattern_soa_[2 * n + i] = pattern_[i].x2;
+    pattern_soa_[3 * n + i] = pattern_[i].y2;
+  }
   levels_.resize(static_cast<std::size_t>(levels));
   for (auto& level : levels_) level.pattern_offsets.resize(pattern_.size() * 2);
   const int r = options_.orientation_radius;
@@ -225,9 +232,16 @@ void OrbExtractor::detect_level(int level) {
 
   const int cols = std::max(1, width / options_.cell_size), rows = std::max(1, height / options_.cell_size);
   // Cell of a corner, by integer arithmetic: cells split the region as evenly as possible.
+  // (tabulated per column and row: two integer divisions per corner cost more than the lookups)
+  auto& cell_col = lv.cell_col;
+  auto& cell_row = lv.cell_row;
+  cell_col.resize(static_cast<std::size_t>(width));
+  cell_row.resize(static_cast<std::size_t>(height));
+  for (int x = 0; x < width; ++x) cell_col[static_cast<std::size_t>(x)] = x * cols / width;
+  for (int y = 0; y < height; ++y) cell_row[static_cast<std::size_t>(y)] = y * rows / height * cols;
   auto cell_of = [&](const detail::FastCorner& k) {
-    const int cx = (k.x - edge) * cols / width, cy = (k.y - edge) * rows / height;
-    return static_cast<std::size_t>(cy * cols + cx);
+    return static_cast<std::size_t>(cell_row[static_cast<std::size_t>(k.y - edge)] +
+                                    cell_col[static_cast<std::size_t>(k.x - edge)]);
   };
   cell_strong.assign(static_cast<std::size_t>(cols * rows), 0);
   const int strong = options_.fast_threshold;
@@ -305,18 +319,31 @@ void OrbExtractor::distribute(int target, Level& level) {
   auto splittable = [](const Node& node) {
     return node.end - node.begin > 1 && node.x1 - node.x0 > 1.0F && node.y1 - node.y0 > 1.0F;
   };
+  // Only which quadrant a corner falls in matters (the order inside a node does not: a node's corners
+  // are ranked by a total order), so the split is a branch-free counting sort over the 4 quadrants
+  // (top left, top right, bottom left, bottom right): the comparisons are coin flips a branch
+  // predictor cannot learn.
+  std::vector<Candidate>& scratch = level.bucketed;
   auto split = [&](const Node& node, std::vector<Node>& out) {
     const float xm = 0.5F * (node.x0 + node.x1), ym = 0.5F * (node.y0 + node.y1);
-    auto* first = candidates.data() + node.begin;
-    auto* last = candidates.data() + node.end;
-    auto* mid_y = std::partition(first, last, [ym](const Candidate& c) { return c.y < ym; });
-    auto* mid_top = std::partition(first, mid_y, [xm](const Candidate& c) { return c.x < xm; });
-    auto* mid_bottom = std::partition(mid_y, last, [xm](const Candidate& c) { return c.x < xm; });
-    const auto index = [&](const Candidate* p) { return static_cast<int>(p - candidates.data()); };
-    const Node children[4] = {{node.x0, node.y0, xm, ym, index(first), index(mid_top)},
-                              {xm, node.y0, node.x1, ym, index(mid_top), index(mid_y)},
-                              {node.x0, ym, xm, node.y1, index(mid_y), index(mid_bottom)},
-                              {xm, ym, node.x1, node.y1, index(mid_bottom), index(last)}};
+    const auto quadrant = [xm, ym](const Candidate& c) {
+      return static_cast<std::size_t>(c.y >= ym) * 2U + static_cast<std::size_t>(c.x >= xm);
+    };
+    const auto first = static_cast<std::size_t>(node.begin), last = static_cast<std::size_t>(node.end);
+    std::array<int, 4> count{};
+    for (std::size_t i = first; i < last; ++i) ++count[quadrant(candidates[i])];
+    std::array<std::size_t, 4> fill{};
+    fill[0] = first;
+    for (std::size_t q = 1; q < 4; ++q) fill[q] = fill[q - 1] + static_cast<std::size_t>(count[q - 1]);
+    const std::array<std::size_t, 4> start = fill;
+    for (std::size_t i = first; i < last; ++i) scratch[fill[quadrant(candidates[i])]++] = candidates[i];
+    std::copy(scratch.begin() + static_cast<std::ptrdiff_t>(first), scratch.begin() + static_cast<std::ptrdiff_t>(last),
+              candidates.begin() + static_cast<std::ptrdiff_t>(first));
+    const auto index = [](std::size_t i) { return static_cast<int>(i); };
+    const Node children[4] = {{node.x0, node.y0, xm, ym, index(start[0]), index(start[1])},
+                              {xm, node.y0, node.x1, ym, index(start[1]), index(start[2])},
+                              {node.x0, ym, xm, node.y1, index(start[2]), index(start[3])},
+                              {xm, ym, node.x1, node.y1, index(start[3]), index(last)}};
     for (const Node& c : children) {
       if (c.end > c.begin) out.push_back(c);
     }
@@ -407,7 +434,6 @@ void OrbExtractor::describe_level(int level) {
   const auto blurred_step = static_cast<int>(blurred.step1());
   constexpr float kRadToDeg = 180.0F / 3.14159265358979323846F;
   constexpr float kDegToRad = 3.14159265358979323846F / 180.0F;
-  const std::size_t pairs = pattern_.size();
   for (const Candidate& c : selected) {
     const int cx = static_cast<int>(c.x), cy = static_cast<int>(c.y);
     // Intensity centroid over the disc: rows +v and -v together.
@@ -440,22 +466,9 @@ void OrbExtractor::describe_level(int level) {
 
     // Rotate the pattern into the keypoint's frame, then compare smoothed intensities.
     const float ca = std::cos(angle * kDegToRad), sa = std::sin(angle * kDegToRad);
-    for (std::size_t i = 0; i < pairs; ++i) {
-      const BriefPair& p = pattern_[i];
-      offsets[2 * i] = round_to_int(p.x1 * sa + p.y1 * ca) * blurred_step + round_to_int(p.x1 * ca - p.y1 * sa);
-      offsets[2 * i + 1] =
-          round_to_int(p.x2 * sa + p.y2 * ca) * blurred_step + round_to_int(p.x2 * ca - p.y2 * sa);
-    }
-    const std::uint8_t* bc = blurred.ptr<std::uint8_t>(cy) + cx;
+    detail::rotate_pattern(pattern_soa_, sa, ca, blurred_step, offsets);
     Descriptor d{};
-    for (std::size_t byte = 0; byte < 32; ++byte) {
-      unsigned bits = 0;
-      for (std::size_t bit = 0; bit < 8; ++bit) {
-        const std::size_t i = byte * 8 + bit;
-        bits |= static_cast<unsigned>(bc[offsets[2 * i]] < bc[offsets[2 * i + 1]]) << bit;
-      }
-      d[byte] = static_cast<std::uint8_t>(bits);
-    }
+    detail::brief_bits(blurred.ptr<std::uint8_t>(cy) + cx, offsets, d.data());
     Keypoint k;
     k.x = c.x * scale;
     k.y = c.y * scale;

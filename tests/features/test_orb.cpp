@@ -2,6 +2,7 @@
 #include "rgbl/features/matcher.hpp"
 #include "rgbl/core/task_pool.hpp"
 #include "rgbl/features/orb.hpp"
+#include "src/features/brief.hpp"
 #include "src/features/fast.hpp"
 #include "support/data.hpp"
 
@@ -223,6 +224,92 @@ TEST_CASE("ORB: orientation is the intensity centroid angle over the radius-15 d
     INFO("keypoint " << i << " level " << k.level);
     REQUIRE(diff < 1e-2);
   }
+}
+
+TEST_CASE("ORB: every descriptor bit is its rotated BRIEF test on the blurred level", "[features][orb]") {
+  // The definition, written plainly: the pattern rotated by the keypoint's angle, each point rounded
+  // half away from zero, bit i set where the smoothed level is darker at the first point than at the
+  // second. The extractor's vectorised paths must give exactly this.
+  const cv::Mat img = textured_image(1226, 370);
+  rgbl::OrbExtractor extractor;
+  std::vector<rgbl::Keypoint> kps;
+  std::vector<rgbl::Descriptor> desc;
+  extractor.extract(img, kps, desc);
+  REQUIRE(kps.size() == 2000);
+  const auto pattern = rgbl::make_brief_pattern(31);
+  REQUIRE(pattern.size() == 256);
+  std::vector<cv::Mat> blurred;
+  for (const cv::Mat& level : extractor.pyramid()) {
+    cv::Mat b;
+    cv::GaussianBlur(level, b, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
+    blurred.push_back(b);
+  }
+  const auto round_away = [](float v) { return static_cast<int>(v >= 0.0F ? v + 0.5F : v - 0.5F); };
+  std::size_t differing_bits = 0;
+  for (std::size_t i = 0; i < kps.size(); ++i) {
+    const auto& k = kps[i];
+    const float s = extractor.level_scales()[static_cast<std::size_t>(k.level)];
+    const int cx = static_cast<int>(std::lround(k.x / s)), cy = static_cast<int>(std::lround(k.y / s));
+    const float rad = k.angle * (3.14159265358979323846F / 180.0F);
+    const float ca = std::cos(rad), sa = std::sin(rad);
+    const cv::Mat& b = blurred[static_cast<std::size_t>(k.level)];
+    for (std::size_t t = 0; t < 256; ++t) {
+      const auto& p = pattern[t];
+      const int y1 = cy + round_away(p.x1 * sa + p.y1 * ca), x1 = cx + round_away(p.x1 * ca - p.y1 * sa);
+      const int y2 = cy + round_away(p.x2 * sa + p.y2 * ca), x2 = cx + round_away(p.x2 * ca - p.y2 * sa);
+      const bool expected = b.at<std::uint8_t>(y1, x1) < b.at<std::uint8_t>(y2, x2);
+      const bool got = ((desc[i][t / 8] >> (t % 8)) & 1U) != 0;
+      differing_bits += expected != got ? 1 : 0;
+    }
+  }
+  REQUIRE(differing_bits == 0);
+}
+
+TEST_CASE("BRIEF kernels: AVX2, SSE2 and the plain formula give the same offsets and bits", "[features][orb]") {
+  // 256 pairs plus 3 (a tail for every vector width), at angles including the axes and halfway
+  // roundings, on a real image stride.
+  auto pattern = rgbl::make_brief_pattern(31);
+  pattern.push_back({0.5F, -0.5F, -2.5F, 1.5F});
+  pattern.push_back({15.0F, 0.0F, 0.0F, -15.0F});
+  pattern.push_back({-7.25F, 3.75F, 2.5F, -0.5F});
+  const std::size_t n = pattern.size();
+  std::vector<float> soa(4 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    soa[i] = pattern[i].x1;
+    soa[n + i] = pattern[i].y1;
+    soa[2 * n + i] = pattern[i].x2;
+    soa[3 * n + i] = pattern[i].y2;
+  }
+  const int step = 1248;
+  const auto round_away = [](float v) { return static_cast<int>(v >= 0.0F ? v + 0.5F : v - 0.5F); };
+  const cv::Mat img = textured_image(200, 200);
+  const std::uint8_t* centre = img.ptr<std::uint8_t>(100) + 100;
+  std::vector<int> with_avx2(2 * n), without(2 * n), plain(2 * n);
+  std::size_t checked = 0;
+  for (const float degrees : {0.0F, 45.0F, 90.0F, 137.3F, 180.0F, 270.0F, 333.3F, 359.99F}) {
+    const float rad = degrees * (3.14159265358979323846F / 180.0F);
+    const float sa = std::sin(rad), ca = std::cos(rad);
+    rgbl::detail::rotate_pattern(soa, sa, ca, step, with_avx2, true);
+    rgbl::detail::rotate_pattern(soa, sa, ca, step, without, false);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& p = pattern[i];
+      plain[i] = round_away(p.x1 * sa + p.y1 * ca) * step + round_away(p.x1 * ca - p.y1 * sa);
+      plain[n + i] = round_away(p.x2 * sa + p.y2 * ca) * step + round_away(p.x2 * ca - p.y2 * sa);
+    }
+    INFO("angle " << degrees);
+    REQUIRE(with_avx2 == plain);
+    REQUIRE(without == plain);
+    // the tests on a 200 x 200 image with stride 200: offsets again for that stride
+    rgbl::detail::rotate_pattern(soa, sa, ca, static_cast<int>(img.step1()), with_avx2);
+    std::array<std::uint8_t, 32> bits{};
+    rgbl::detail::brief_bits(centre, with_avx2, bits.data());
+    for (std::size_t t = 0; t < 256; ++t) {
+      const bool expected = centre[with_avx2[t]] < centre[with_avx2[n + t]];
+      REQUIRE((((bits[t / 8] >> (t % 8)) & 1U) != 0) == expected);
+      ++checked;
+    }
+  }
+  REQUIRE(checked == 8 * 256);
 }
 
 static_assert(!std::is_copy_constructible_v<rgbl::OrbExtractor>);

@@ -106,6 +106,7 @@ class OrbExtractor {
     std::vector<detail::FastCorner> fast;
     std::vector<std::uint8_t> fast_scores;
     std::vector<unsigned char> cell_strong;
+    std::vector<int> cell_col, cell_row;  // cell column of each x and cell row (times columns) of each y
     std::vector<Candidate> candidates;
     std::vector<Candidate> selected;
     // the quadtree's scratch
@@ -129,6 +130,8 @@ class OrbExtractor {
   std::vector<float> scales_;
   std::vector<int> budgets_;
   std::vector<BriefPair> pattern_;
+  // The same pairs as four coordinate arrays (x1..., y1..., x2..., y2...), for rotating 4 at a time.
+  std::vector<float> pattern_soa_;
   std::vector<int> disc_half_width_;  // per row offset 0..radius: half width of the orientation disc
   std::vector<std::uint8_t> disc_masks_;  // the same disc as 32-byte row masks for the SIMD path
   // Scratch reused across calls.
