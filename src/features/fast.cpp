@@ -80,15 +80,18 @@ inline void block_scores(const std::uint8_t* centre, const std::array<int, 16>& 
     b[k] = _mm_subs_epu8(p, c);
     d[k] = _mm_subs_epu8(c, p);
   }
-  // Minimum over every cyclic window of 9 by doubling: 2, 4, 8, then one more.
+  // The best minimum over the 16 cyclic windows of 9, two windows at a time: for even k, windows k
+  // and k + 1 share v[k+1..k+8], so max(min over window k, min over window k + 1) =
+  // min(min(v[k+1..k+8]), max(v[k], v[k+9])). The shared 8-minima at odd starts come by doubling
+  // (2, 4, 8) from odd starts only: 48 min/max per side instead of 80.
   auto best_arc = [](const __m128i* v) {
     __m128i m2[16], m4[16];
-    for (int k = 0; k < 16; ++k) m2[k] = _mm_min_epu8(v[k], v[(k + 1) & 15]);
-    for (int k = 0; k < 16; ++k) m4[k] = _mm_min_epu8(m2[k], m2[(k + 2) & 15]);
+    for (int j = 1; j < 16; j += 2) m2[j] = _mm_min_epu8(v[j], v[(j + 1) & 15]);
+    for (int j = 1; j < 16; j += 2) m4[j] = _mm_min_epu8(m2[j], m2[(j + 2) & 15]);
     __m128i best = _mm_setzero_si128();
-    for (int k = 0; k < 16; ++k) {
-      const __m128i m9 = _mm_min_epu8(_mm_min_epu8(m4[k], m4[(k + 4) & 15]), v[(k + 8) & 15]);
-      best = _mm_max_epu8(best, m9);
+    for (int k = 0; k < 16; k += 2) {
+      const __m128i m8 = _mm_min_epu8(m4[k + 1], m4[(k + 5) & 15]);
+      best = _mm_max_epu8(best, _mm_min_epu8(m8, _mm_max_epu8(v[k], v[(k + 9) & 15])));
     }
     return best;
   };
@@ -145,11 +148,12 @@ __attribute__((target("avx2"))) void row_scores_avx2(const std::uint8_t* row, in
       }
       __m256i best = _mm256_setzero_si256();
       for (const __m256i* v : {static_cast<const __m256i*>(b), static_cast<const __m256i*>(d)}) {
-        __m256i m2[16], m4[16];
-        for (int k = 0; k < 16; ++k) m2[k] = _mm256_min_epu8(v[k], v[(k + 1) & 15]);
-        for (int k = 0; k < 16; ++k) m4[k] = _mm256_min_epu8(m2[k], m2[(k + 2) & 15]);
-        for (int k = 0; k < 16; ++k) {
-          best = _mm256_max_epu8(best, _mm256_min_epu8(_mm256_min_epu8(m4[k], m4[(k + 4) & 15]), v[(k + 8) & 15]));
+        __m256i m2[16], m4[16];  // as in block_scores: two windows of 9 at a time, odd starts only
+        for (int j = 1; j < 16; j += 2) m2[j] = _mm256_min_epu8(v[j], v[(j + 1) & 15]);
+        for (int j = 1; j < 16; j += 2) m4[j] = _mm256_min_epu8(m2[j], m2[(j + 2) & 15]);
+        for (int k = 0; k < 16; k += 2) {
+          const __m256i m8 = _mm256_min_epu8(m4[k + 1], m4[(k + 5) & 15]);
+          best = _mm256_max_epu8(best, _mm256_min_epu8(m8, _mm256_max_epu8(v[k], v[(k + 9) & 15])));
         }
       }
       const __m256i corner = _mm256_cmpeq_epi8(_mm256_max_epu8(best, t1), best);
@@ -172,39 +176,93 @@ bool cpu_has_avx2() {
 #endif
 }
 
+namespace {
+
+std::array<int, 16> circle_offsets(const cv::Mat& img) {
+  const auto step = static_cast<int>(img.step1());
+  std::array<int, 16> offsets{};
+  for (std::size_t k = 0; k < 16; ++k) offsets[k] = kCircle[k][1] * step + kCircle[k][0];
+  return offsets;
+}
+
+// Scores of image row y over the region's columns into out[0, region.width).
+void score_row(const cv::Mat& img, cv::Rect region, int y, const std::array<int, 16>& offsets, int threshold,
+               std::uint8_t* out, bool allow_avx2) {
+  const std::uint8_t* row = img.ptr<std::uint8_t>(y);
+  int x = region.x;
+  const int end = region.x + region.width;
+#if !defined(RGBL_HAVE_AVX2_PATH)
+  (void)allow_avx2;
+#else
+  if (allow_avx2 && region.width >= 32 && cpu_has_avx2()) {
+    row_scores_avx2(row, x, end, offsets, threshold, out);
+    return;
+  }
+#endif
+#if defined(__SSE2__)
+  if (region.width >= 16) {
+    for (; x + 16 <= end; x += 16) block_scores(row + x, offsets, threshold, out + (x - region.x));
+    // The tail as one more (overlapping) block: it rewrites the same values.
+    if (x < end) block_scores(row + end - 16, offsets, threshold, out + (end - 16 - region.x));
+    x = end;
+  }
+#endif
+  for (; x < end; ++x) {
+    const int s = pixel_score(row + x, offsets);
+    out[x - region.x] = static_cast<std::uint8_t>(s >= threshold ? s : 0);
+  }
+}
+
+// Appends the 3x3 maxima of map row `mid` (rows of width + 2 entries with a zero column at each end,
+// 16 entries of readable padding after) as corners of image row y.
+void suppress_row(const std::uint8_t* up, const std::uint8_t* mid, const std::uint8_t* down, cv::Rect region, int y,
+                  std::vector<FastCorner>& corners) {
+#if defined(__SSE2__)
+  // 16 map entries at a time, the local-maximum test done on all of them with unsigned byte
+  // compares (a > b as max(a, b) == a and a != b).
+  for (int x = 1; x <= region.width; x += 16) {
+    const __m128i s = load(mid + x);
+    const __m128i zero = _mm_setzero_si128();
+    auto mask = static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(s, zero))) ^ 0xFFFFU;
+    if (mask == 0) continue;
+    auto ge = [&](const std::uint8_t* p) { return _mm_cmpeq_epi8(_mm_max_epu8(s, load(p)), s); };
+    auto gt = [&](const std::uint8_t* p) {
+      const __m128i n = load(p);
+      return _mm_andnot_si128(_mm_cmpeq_epi8(s, n), _mm_cmpeq_epi8(_mm_max_epu8(s, n), s));
+    };
+    const __m128i keep = _mm_and_si128(
+        _mm_and_si128(_mm_and_si128(gt(up + x - 1), gt(up + x)), _mm_and_si128(gt(up + x + 1), gt(mid + x - 1))),
+        _mm_and_si128(_mm_and_si128(ge(mid + x + 1), ge(down + x - 1)), _mm_and_si128(ge(down + x), ge(down + x + 1))));
+    mask &= static_cast<unsigned>(_mm_movemask_epi8(keep));
+    if (region.width - x + 1 < 16) mask &= (1U << static_cast<unsigned>(region.width - x + 1)) - 1U;
+    while (mask != 0) {
+      const int bit = __builtin_ctz(mask);
+      mask &= mask - 1U;
+      corners.push_back({region.x + x + bit - 1, y, mid[x + bit]});
+    }
+  }
+#else
+  for (int x = 1; x <= region.width; ++x) {
+    const int s = mid[x];
+    if (s != 0 && s > up[x - 1] && s > up[x] && s > up[x + 1] && s > mid[x - 1] && s >= mid[x + 1] &&
+        s >= down[x - 1] && s >= down[x] && s >= down[x + 1]) {
+      corners.push_back({region.x + x - 1, y, s});
+    }
+  }
+#endif
+}
+
+}  // namespace
+
 void fast_score_map(const cv::Mat& img, cv::Rect region, int threshold, std::vector<std::uint8_t>& scores,
                     bool allow_avx2) {
   const int map_w = region.width + 2;
   // 16 bytes of padding let the non-maximum pass read whole 16-byte blocks at the end of the map.
   scores.assign(static_cast<std::size_t>(map_w) * static_cast<std::size_t>(region.height + 2) + 16, 0);
-  const auto step = static_cast<int>(img.step1());
-  std::array<int, 16> offsets{};
-  for (std::size_t k = 0; k < 16; ++k) offsets[k] = kCircle[k][1] * step + kCircle[k][0];
+  const auto offsets = circle_offsets(img);
   for (int y = region.y; y < region.y + region.height; ++y) {
-    const std::uint8_t* row = img.ptr<std::uint8_t>(y);
     std::uint8_t* out = scores.data() + static_cast<std::size_t>(y - region.y + 1) * static_cast<std::size_t>(map_w) + 1;
-    int x = region.x;
-    const int end = region.x + region.width;
-#if !defined(RGBL_HAVE_AVX2_PATH)
-    (void)allow_avx2;
-#else
-    if (allow_avx2 && region.width >= 32 && cpu_has_avx2()) {
-      row_scores_avx2(row, x, end, offsets, threshold, out);
-      continue;
-    }
-#endif
-#if defined(__SSE2__)
-    if (region.width >= 16) {
-      for (; x + 16 <= end; x += 16) block_scores(row + x, offsets, threshold, out + (x - region.x));
-      // The tail as one more (overlapping) block: it rewrites the same values.
-      if (x < end) block_scores(row + end - 16, offsets, threshold, out + (end - 16 - region.x));
-      x = end;
-    }
-#endif
-    for (; x < end; ++x) {
-      const int s = pixel_score(row + x, offsets);
-      out[x - region.x] = static_cast<std::uint8_t>(s >= threshold ? s : 0);
-    }
+    score_row(img, region, y, offsets, threshold, out, allow_avx2);
   }
 }
 
@@ -212,45 +270,22 @@ void detect_fast(const cv::Mat& img, cv::Rect region, int threshold, std::vector
                  std::vector<FastCorner>& corners) {
   corners.clear();
   if (region.width <= 0 || region.height <= 0) return;
-  fast_score_map(img, region, threshold, scores);
-  const int map_w = region.width + 2;
-  for (int y = 1; y <= region.height; ++y) {
-    const std::uint8_t* up = scores.data() + static_cast<std::size_t>(y - 1) * static_cast<std::size_t>(map_w);
-    const std::uint8_t* mid = up + map_w;
-    const std::uint8_t* down = mid + map_w;
-#if defined(__SSE2__)
-    // 16 map entries at a time, the local-maximum test done on all of them with unsigned byte
-    // compares (a > b as max(a, b) == a and a != b); the map is padded so whole blocks can be read.
-    for (int x = 1; x <= region.width; x += 16) {
-      const __m128i s = load(mid + x);
-      const __m128i zero = _mm_setzero_si128();
-      auto mask = static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(s, zero))) ^ 0xFFFFU;
-      if (mask == 0) continue;
-      auto ge = [&](const std::uint8_t* p) { return _mm_cmpeq_epi8(_mm_max_epu8(s, load(p)), s); };
-      auto gt = [&](const std::uint8_t* p) {
-        const __m128i n = load(p);
-        return _mm_andnot_si128(_mm_cmpeq_epi8(s, n), _mm_cmpeq_epi8(_mm_max_epu8(s, n), s));
-      };
-      const __m128i keep = _mm_and_si128(
-          _mm_and_si128(_mm_and_si128(gt(up + x - 1), gt(up + x)), _mm_and_si128(gt(up + x + 1), gt(mid + x - 1))),
-          _mm_and_si128(_mm_and_si128(ge(mid + x + 1), ge(down + x - 1)), _mm_and_si128(ge(down + x), ge(down + x + 1))));
-      mask &= static_cast<unsigned>(_mm_movemask_epi8(keep));
-      if (region.width - x + 1 < 16) mask &= (1U << static_cast<unsigned>(region.width - x + 1)) - 1U;
-      while (mask != 0) {
-        const int bit = __builtin_ctz(mask);
-        mask &= mask - 1U;
-        corners.push_back({region.x + x + bit - 1, region.y + y - 1, mid[x + bit]});
-      }
+  // The map's rows in a ring of three (previous, current, next), so each row is suppressed while its
+  // neighbours are still in L1, instead of writing and re-reading a map of the whole level.
+  const auto map_w = static_cast<std::size_t>(region.width) + 2;
+  scores.assign(3 * map_w + 16, 0);
+  const auto offsets = circle_offsets(img);
+  const auto ring = [&](int map_row) { return scores.data() + static_cast<std::size_t>(map_row % 3) * map_w; };
+  // map row r holds image row region.y + r - 1; rows 0 and height + 1 are zero
+  score_row(img, region, region.y, offsets, threshold, ring(1) + 1, true);
+  for (int r = 1; r <= region.height; ++r) {
+    std::uint8_t* next = ring(r + 1);
+    if (r < region.height) {
+      score_row(img, region, region.y + r, offsets, threshold, next + 1, true);
+    } else {
+      std::fill(next, next + map_w, std::uint8_t{0});
     }
-#else
-    for (int x = 1; x <= region.width; ++x) {
-      const int s = mid[x];
-      if (s != 0 && s > up[x - 1] && s > up[x] && s > up[x + 1] && s > mid[x - 1] && s >= mid[x + 1] &&
-          s >= down[x - 1] && s >= down[x] && s >= down[x + 1]) {
-        corners.push_back({region.x + x - 1, region.y + y - 1, s});
-      }
-    }
-#endif
+    suppress_row(ring(r - 1), ring(r), next, region, region.y + r - 1, corners);
   }
 }
 

@@ -409,6 +409,20 @@ void OrbExtractor::distribute(int target, Level& level) {
     leftover.insert(leftover.end(), candidates.begin() + node.begin + keep, candidates.begin() + node.end);
   }
   const auto take = std::min(static_cast<std::size_t>(rest), leftover.size());
+  if (take == 0) return;
+  // Responses are FAST scores (whole numbers up to 255): a histogram finds the weakest response the
+  // `take` strongest can have, and only corners at least that strong are ranked.
+  std::array<int, 256> histogram{};
+  for (const Candidate& c : leftover) ++histogram[static_cast<std::size_t>(c.response)];
+  std::size_t weakest = 255, at_least = static_cast<std::size_t>(histogram[255]);
+  while (at_least < take) at_least += static_cast<std::size_t>(histogram[--weakest]);
+  const auto floor = static_cast<float>(weakest);
+  std::size_t kept = 0;
+  for (const Candidate& c : leftover) {  // branch-free compaction, in place
+    leftover[kept] = c;
+    kept += c.response >= floor ? 1 : 0;
+  }
+  leftover.resize(kept);
   std::partial_sort(leftover.begin(), leftover.begin() + static_cast<std::ptrdiff_t>(take), leftover.end(), stronger);
   selected.insert(selected.end(), leftover.begin(), leftover.begin() + static_cast<std::ptrdiff_t>(take));
 }

@@ -161,6 +161,34 @@ TEST_CASE("FAST scores: the same corner set as cv::FAST at every threshold", "[f
   CHECK(checked == 50);
 }
 
+TEST_CASE("FAST corners: the 3x3 maxima of the score map, ties to the first in row-major order", "[features][orb]") {
+  const cv::Mat img = textured_image();
+  std::vector<std::uint8_t> map, scratch;
+  std::vector<rgbl::detail::FastCorner> corners;
+  for (const cv::Rect region : {cv::Rect(3, 3, img.cols - 6, img.rows - 6), cv::Rect(19, 40, 77, 1),
+                                cv::Rect(19, 40, 5, 33), cv::Rect(100, 3, 200, 2)}) {
+    rgbl::detail::fast_score_map(img, region, 7, map);
+    const auto at = [&](int x, int y) {  // map entry of region pixel (x, y); zero outside
+      return static_cast<int>(map[static_cast<std::size_t>((y + 1) * (region.width + 2) + x + 1)]);
+    };
+    std::vector<std::tuple<int, int, int>> expected, got;
+    for (int y = 0; y < region.height; ++y) {
+      for (int x = 0; x < region.width; ++x) {
+        const int s = at(x, y);
+        if (s != 0 && s > at(x - 1, y - 1) && s > at(x, y - 1) && s > at(x + 1, y - 1) && s > at(x - 1, y) &&
+            s >= at(x + 1, y) && s >= at(x - 1, y + 1) && s >= at(x, y + 1) && s >= at(x + 1, y + 1)) {
+          expected.emplace_back(region.x + x, region.y + y, s);
+        }
+      }
+    }
+    rgbl::detail::detect_fast(img, region, 7, scratch, corners);
+    for (const auto& c : corners) got.emplace_back(c.x, c.y, c.score);
+    INFO("region " << region);
+    CHECK(got == expected);
+    if (region.height > 100) CHECK(expected.size() > 500);
+  }
+}
+
 TEST_CASE("ORB: exact feature count, levels, borders and budgets on a real frame", "[features][orb]") {
   const auto img = kitti_frame();
   if (!img) return;

@@ -95,7 +95,7 @@ class OrbExtractor {
  private:
   struct Candidate {
     float x, y;  // level pixels
-    float response;
+    float response;  // the FAST score: a whole number in [0, 255]
   };
   struct Node {
     float x0, y0, x1, y1;
