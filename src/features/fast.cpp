@@ -270,22 +270,26 @@ void detect_fast(const cv::Mat& img, cv::Rect region, int threshold, std::vector
                  std::vector<FastCorner>& corners) {
   corners.clear();
   if (region.width <= 0 || region.height <= 0) return;
-  // The map's rows in a ring of three (previous, current, next), so each row is suppressed while its
-  // neighbours are still in L1, instead of writing and re-reading a map of the whole level.
+  // The map's rows in a ring of four, so each row is suppressed while its neighbours are still in L1,
+  // instead of writing and re-reading a map of the whole level; scoring runs two rows ahead, so no
+  // row is read right after it was written (its unaligned reads would wait on the stores).
   const auto map_w = static_cast<std::size_t>(region.width) + 2;
-  scores.assign(3 * map_w + 16, 0);
+  scores.assign(4 * map_w + 16, 0);
   const auto offsets = circle_offsets(img);
-  const auto ring = [&](int map_row) { return scores.data() + static_cast<std::size_t>(map_row % 3) * map_w; };
-  // map row r holds image row region.y + r - 1; rows 0 and height + 1 are zero
-  score_row(img, region, region.y, offsets, threshold, ring(1) + 1, true);
-  for (int r = 1; r <= region.height; ++r) {
-    std::uint8_t* next = ring(r + 1);
-    if (r < region.height) {
-      score_row(img, region, region.y + r, offsets, threshold, next + 1, true);
-    } else {
-      std::fill(next, next + map_w, std::uint8_t{0});
+  const auto ring = [&](int map_row) { return scores.data() + static_cast<std::size_t>(map_row % 4) * map_w; };
+  // map row m holds image row region.y + m - 1; rows 0 and height + 1 are zero
+  const auto produce = [&](int m) {
+    if (m >= 1 && m <= region.height) {
+      score_row(img, region, region.y + m - 1, offsets, threshold, ring(m) + 1, true);
+    } else if (m == region.height + 1) {
+      std::fill(ring(m), ring(m) + map_w, std::uint8_t{0});
     }
-    suppress_row(ring(r - 1), ring(r), next, region, region.y + r - 1, corners);
+  };
+  produce(1);
+  produce(2);
+  for (int r = 1; r <= region.height; ++r) {
+    produce(r + 2);
+    suppress_row(ring(r - 1), ring(r), ring(r + 1), region, region.y + r - 1, corners);
   }
 }
 

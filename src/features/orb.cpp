@@ -5,6 +5,7 @@
 
 #include "brief.hpp"
 #include "fast.hpp"
+#include "smooth.hpp"
 
 #include <opencv2/imgproc.hpp>
 
@@ -440,8 +441,7 @@ void OrbExtractor::describe_level(int level) {
   keypoints.reserve(selected.size());
   descriptors.reserve(selected.size());
   const cv::Mat& img = pyramid_[static_cast<std::size_t>(level)];
-  cv::GaussianBlur(img, blurred, cv::Size(options_.blur_size, options_.blur_size), options_.blur_sigma,
-                   options_.blur_sigma, cv::BORDER_REFLECT_101);
+  detail::smooth_for_brief(img, blurred, options_.blur_size, options_.blur_sigma);
   const float scale = scales_[static_cast<std::size_t>(level)];
   const int r = options_.orientation_radius;
   const auto step = static_cast<int>(img.step1());

@@ -4,6 +4,7 @@
 #include "rgbl/features/orb.hpp"
 #include "src/features/brief.hpp"
 #include "src/features/fast.hpp"
+#include "src/features/smooth.hpp"
 #include "support/data.hpp"
 
 #include <catch2/catch.hpp>
@@ -187,6 +188,38 @@ TEST_CASE("FAST corners: the 3x3 maxima of the score map, ties to the first in r
     CHECK(got == expected);
     if (region.height > 100) CHECK(expected.size() > 500);
   }
+}
+
+TEST_CASE("BRIEF smoothing: the same pixels as cv::GaussianBlur 7x7, sigma 2, at every size", "[features][orb]") {
+  // Random pixels (every value and edge), the textured scene and a real frame, from the smallest
+  // size the fast path takes (16 x 4) up, odd widths with a tail block, and sizes it leaves to OpenCV.
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> value(0, 255);
+  std::vector<cv::Mat> images;
+  for (const auto& [w, h] : std::vector<std::pair<int, int>>{
+           {16, 4}, {17, 5}, {31, 7}, {33, 9}, {64, 64}, {101, 37}, {346, 105}, {15, 20}, {40, 3}}) {
+    cv::Mat img(h, w, CV_8UC1);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) img.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(value(rng));
+    }
+    images.push_back(img);
+  }
+  images.push_back(cv::Mat(50, 70, CV_8UC1, cv::Scalar(255)));  // the largest sums
+  images.push_back(textured_image(1226, 370));
+  if (const auto frame = kitti_frame()) images.push_back(*frame);
+  for (const cv::Mat& img : images) {
+    cv::Mat ours, reference;
+    rgbl::detail::smooth_for_brief(img, ours, 7, 2.0);
+    cv::GaussianBlur(img, reference, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
+    INFO("size " << img.cols << " x " << img.rows);
+    REQUIRE(ours.size() == img.size());
+    CHECK(cv::countNonZero(ours != reference) == 0);
+  }
+  // Other kernels go to OpenCV.
+  cv::Mat ours, reference;
+  rgbl::detail::smooth_for_brief(images[4], ours, 5, 1.5);
+  cv::GaussianBlur(images[4], reference, cv::Size(5, 5), 1.5, 1.5, cv::BORDER_REFLECT_101);
+  CHECK(cv::countNonZero(ours != reference) == 0);
 }
 
 TEST_CASE("ORB: exact feature count, levels, borders and budgets on a real frame", "[features][orb]") {
