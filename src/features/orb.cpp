@@ -441,7 +441,7 @@ void OrbExtractor::describe_level(int level) {
   keypoints.reserve(selected.size());
   descriptors.reserve(selected.size());
   const cv::Mat& img = pyramid_[static_cast<std::size_t>(level)];
-  detail::smooth_for_brief(img, blurred, options_.blur_size, options_.blur_sigma);
+  detail::smooth_for_brief(img, blurred, options_.blur_size, options_.blur_sigma, lv.smooth_row, lv.smooth_rows);
   const float scale = scales_[static_cast<std::size_t>(level)];
   const int r = options_.orientation_radius;
   const auto step = static_cast<int>(img.step1());

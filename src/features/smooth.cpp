@@ -76,11 +76,13 @@ __attribute__((target("avx2"))) void column_pass(const std::uint16_t* const* hi,
   }
 }
 
-__attribute__((target("avx2"))) void smooth_avx2(const cv::Mat& src, cv::Mat& dst) {
+__attribute__((target("avx2"))) void smooth_avx2(const cv::Mat& src, cv::Mat& dst, std::vector<std::uint8_t>& padded,
+                                                 std::vector<std::uint16_t>& ring) {
   const int w = src.cols, h = src.rows;
   const auto stride = static_cast<std::size_t>(w) + 16;
-  std::vector<std::uint8_t> padded(static_cast<std::size_t>(w) + 6 + 32);
-  std::vector<std::uint16_t> ring(2 * 8 * stride);  // the row passes of 8 source rows (7 in use)
+  // ring: the row passes of 8 source rows (7 in use), high bytes then low bytes
+  padded.resize(static_cast<std::size_t>(w) + 6 + 32);
+  ring.resize(2 * 8 * stride);
   const auto hi_row = [&](int y) { return ring.data() + static_cast<std::size_t>(y % 8) * stride; };
   const auto lo_row = [&](int y) { return ring.data() + (8 + static_cast<std::size_t>(y % 8)) * stride; };
   const auto reflect = [&](int y) { return y < 0 ? -y : (y >= h ? 2 * h - 2 - y : y); };
@@ -112,18 +114,21 @@ __attribute__((target("avx2"))) void smooth_avx2(const cv::Mat& src, cv::Mat& ds
 
 }  // namespace
 
-void smooth_for_brief(const cv::Mat& src, cv::Mat& dst, int size, double sigma, bool allow_fast) {
+void smooth_for_brief(const cv::Mat& src, cv::Mat& dst, int size, double sigma, std::vector<std::uint8_t>& padded,
+                      std::vector<std::uint16_t>& rows, bool allow_fast) {
 #if defined(RGBL_HAVE_AVX2_PATH)
   // The rows kept are the last 8 (with row y + 3 computed, the oldest needed is y - 3, or a reflected
   // row between them); reflection needs 4 rows, the overlapping tail block 16 columns.
   if (allow_fast && size == 7 && sigma == 2.0 && src.type() == CV_8UC1 && src.cols >= 16 && src.rows >= 4 &&
       cpu_has_avx2()) {
     if (dst.size() != src.size() || dst.type() != CV_8UC1 || dst.data == src.data) dst.create(src.size(), CV_8UC1);
-    smooth_avx2(src, dst);
+    smooth_avx2(src, dst, padded, rows);
     return;
   }
 #else
   (void)allow_fast;
+  (void)padded;
+  (void)rows;
 #endif
   cv::GaussianBlur(src, dst, cv::Size(size, size), sigma, sigma, cv::BORDER_REFLECT_101);
 }

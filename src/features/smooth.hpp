@@ -6,10 +6,15 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include <cstdint>
+#include <vector>
+
 namespace rgbl::detail {
 
 // dst = cv::GaussianBlur(src, (size, size), sigma, sigma, BORDER_REFLECT_101) for CV_8UC1 `src`.
-// `allow_fast = false` always calls OpenCV, for tests.
-void smooth_for_brief(const cv::Mat& src, cv::Mat& dst, int size, double sigma, bool allow_fast = true);
+// `padded` and `rows` are scratch kept between calls (a padded source row, the row passes of 8
+// rows). `allow_fast = false` always calls OpenCV, for tests.
+void smooth_for_brief(const cv::Mat& src, cv::Mat& dst, int size, double sigma, std::vector<std::uint8_t>& padded,
+                      std::vector<std::uint16_t>& rows, bool allow_fast = true);
 
 }  // namespace rgbl::detail

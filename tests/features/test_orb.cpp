@@ -209,7 +209,9 @@ TEST_CASE("BRIEF smoothing: the same pixels as cv::GaussianBlur 7x7, sigma 2, at
   if (const auto frame = kitti_frame()) images.push_back(*frame);
   for (const cv::Mat& img : images) {
     cv::Mat ours, reference;
-    rgbl::detail::smooth_for_brief(img, ours, 7, 2.0);
+    std::vector<std::uint8_t> padded;
+    std::vector<std::uint16_t> rows;
+    rgbl::detail::smooth_for_brief(img, ours, 7, 2.0, padded, rows);
     cv::GaussianBlur(img, reference, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
     INFO("size " << img.cols << " x " << img.rows);
     REQUIRE(ours.size() == img.size());
@@ -217,7 +219,9 @@ TEST_CASE("BRIEF smoothing: the same pixels as cv::GaussianBlur 7x7, sigma 2, at
   }
   // Other kernels go to OpenCV.
   cv::Mat ours, reference;
-  rgbl::detail::smooth_for_brief(images[4], ours, 5, 1.5);
+  std::vector<std::uint8_t> padded;
+  std::vector<std::uint16_t> rows;
+  rgbl::detail::smooth_for_brief(images[4], ours, 5, 1.5, padded, rows);
   cv::GaussianBlur(images[4], reference, cv::Size(5, 5), 1.5, 1.5, cv::BORDER_REFLECT_101);
   CHECK(cv::countNonZero(ours != reference) == 0);
 }

@@ -115,6 +115,8 @@ class OrbExtractor {
     std::vector<Candidate> leftover;  // corners the quadtree did not take
     std::vector<Node> nodes, next_nodes;
     cv::Mat blurred;
+    std::vector<std::uint8_t> smooth_row;  // the smoothing's scratch
+    std::vector<std::uint16_t> smooth_rows;
     std::vector<int> pattern_offsets;
     std::vector<Keypoint> keypoints;
     std::vector<Descriptor> descriptors;
