@@ -140,22 +140,31 @@ __attribute__((target("avx2"))) void row_scores_avx2(const std::uint8_t* row, in
     if (_mm256_movemask_epi8(possible) == 0) {
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst), _mm256_setzero_si256());
     } else {
+      // On the circle's pixels themselves: the min over an arc of (p - c)+ is (min over the arc of
+      // p - c)+, and the min of (c - p)+ is (c - max over the arc of p)+, so the brightest arc's
+      // minimum and the darkest arc's maximum give the score with two subtractions in all. Two windows
+      // of 9 at a time as in block_scores (odd starts only).
+      __m256i p[16];
       for (int k = 0; k < 16; ++k) {
-        if (k % 4 == 0) continue;
-        const __m256i p = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(centre + offsets[static_cast<std::size_t>(k)]));
-        b[k] = _mm256_subs_epu8(p, c);
-        d[k] = _mm256_subs_epu8(c, p);
+        p[k] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(centre + offsets[static_cast<std::size_t>(k)]));
       }
-      __m256i best = _mm256_setzero_si256();
-      for (const __m256i* v : {static_cast<const __m256i*>(b), static_cast<const __m256i*>(d)}) {
-        __m256i m2[16], m4[16];  // as in block_scores: two windows of 9 at a time, odd starts only
-        for (int j = 1; j < 16; j += 2) m2[j] = _mm256_min_epu8(v[j], v[(j + 1) & 15]);
-        for (int j = 1; j < 16; j += 2) m4[j] = _mm256_min_epu8(m2[j], m2[(j + 2) & 15]);
-        for (int k = 0; k < 16; k += 2) {
-          const __m256i m8 = _mm256_min_epu8(m4[k + 1], m4[(k + 5) & 15]);
-          best = _mm256_max_epu8(best, _mm256_min_epu8(m8, _mm256_max_epu8(v[k], v[(k + 9) & 15])));
-        }
+      __m256i lo2[16], lo4[16], hi2[16], hi4[16];
+      for (int j = 1; j < 16; j += 2) {
+        lo2[j] = _mm256_min_epu8(p[j], p[(j + 1) & 15]);
+        hi2[j] = _mm256_max_epu8(p[j], p[(j + 1) & 15]);
       }
+      for (int j = 1; j < 16; j += 2) {
+        lo4[j] = _mm256_min_epu8(lo2[j], lo2[(j + 2) & 15]);
+        hi4[j] = _mm256_max_epu8(hi2[j], hi2[(j + 2) & 15]);
+      }
+      __m256i brightest = _mm256_setzero_si256(), darkest = _mm256_set1_epi8(static_cast<char>(0xFF));
+      for (int k = 0; k < 16; k += 2) {
+        const __m256i lo8 = _mm256_min_epu8(lo4[k + 1], lo4[(k + 5) & 15]);
+        const __m256i hi8 = _mm256_max_epu8(hi4[k + 1], hi4[(k + 5) & 15]);
+        brightest = _mm256_max_epu8(brightest, _mm256_min_epu8(lo8, _mm256_max_epu8(p[k], p[(k + 9) & 15])));
+        darkest = _mm256_min_epu8(darkest, _mm256_max_epu8(hi8, _mm256_min_epu8(p[k], p[(k + 9) & 15])));
+      }
+      const __m256i best = _mm256_max_epu8(_mm256_subs_epu8(brightest, c), _mm256_subs_epu8(c, darkest));
       const __m256i corner = _mm256_cmpeq_epi8(_mm256_max_epu8(best, t1), best);
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst), _mm256_and_si256(corner, _mm256_subs_epu8(best, one)));
     }
@@ -213,6 +222,37 @@ void score_row(const cv::Mat& img, cv::Rect region, int y, const std::array<int,
   }
 }
 
+#if defined(RGBL_HAVE_AVX2_PATH)
+// suppress_row on 32 map entries per step (the rows need 32 readable bytes of padding).
+__attribute__((target("avx2"))) void suppress_row_avx2(const std::uint8_t* up, const std::uint8_t* mid,
+                                                       const std::uint8_t* down, cv::Rect region, int y,
+                                                       std::vector<FastCorner>& corners) {
+  const __m256i zero = _mm256_setzero_si256();
+  for (int x = 1; x <= region.width; x += 32) {
+    const __m256i s = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(mid + x));
+    auto mask = ~static_cast<unsigned>(_mm256_movemask_epi8(_mm256_cmpeq_epi8(s, zero)));
+    if (mask == 0) continue;
+    const auto n = [](const std::uint8_t* q) { return q; };
+    __m256i keep = _mm256_set1_epi8(static_cast<char>(0xFF));
+    for (const std::uint8_t* q : {n(up + x - 1), n(up + x), n(up + x + 1), n(mid + x - 1)}) {  // s > neighbour
+      const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(q));
+      keep = _mm256_and_si256(keep, _mm256_andnot_si256(_mm256_cmpeq_epi8(s, v), _mm256_cmpeq_epi8(_mm256_max_epu8(s, v), s)));
+    }
+    for (const std::uint8_t* q : {n(mid + x + 1), n(down + x - 1), n(down + x), n(down + x + 1)}) {  // s >= neighbour
+      const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(q));
+      keep = _mm256_and_si256(keep, _mm256_cmpeq_epi8(_mm256_max_epu8(s, v), s));
+    }
+    mask &= static_cast<unsigned>(_mm256_movemask_epi8(keep));
+    if (region.width - x + 1 < 32) mask &= (1U << static_cast<unsigned>(region.width - x + 1)) - 1U;
+    while (mask != 0) {
+      const int bit = __builtin_ctz(mask);
+      mask &= mask - 1U;
+      corners.push_back({region.x + x + bit - 1, y, mid[x + bit]});
+    }
+  }
+}
+#endif
+
 // Appends the 3x3 maxima of map row `mid` (rows of width + 2 entries with a zero column at each end,
 // 16 entries of readable padding after) as corners of image row y.
 void suppress_row(const std::uint8_t* up, const std::uint8_t* mid, const std::uint8_t* down, cv::Rect region, int y,
@@ -267,28 +307,36 @@ void fast_score_map(const cv::Mat& img, cv::Rect region, int threshold, std::vec
 }
 
 void detect_fast(const cv::Mat& img, cv::Rect region, int threshold, std::vector<std::uint8_t>& scores,
-                 std::vector<FastCorner>& corners) {
+                 std::vector<FastCorner>& corners, bool allow_avx2) {
   corners.clear();
   if (region.width <= 0 || region.height <= 0) return;
   // The map's rows in a ring of four, so each row is suppressed while its neighbours are still in L1,
   // instead of writing and re-reading a map of the whole level; scoring runs two rows ahead, so no
   // row is read right after it was written (its unaligned reads would wait on the stores).
   const auto map_w = static_cast<std::size_t>(region.width) + 2;
-  scores.assign(4 * map_w + 16, 0);
+  scores.assign(4 * map_w + 32, 0);
   const auto offsets = circle_offsets(img);
   const auto ring = [&](int map_row) { return scores.data() + static_cast<std::size_t>(map_row % 4) * map_w; };
   // map row m holds image row region.y + m - 1; rows 0 and height + 1 are zero
   const auto produce = [&](int m) {
     if (m >= 1 && m <= region.height) {
-      score_row(img, region, region.y + m - 1, offsets, threshold, ring(m) + 1, true);
+      score_row(img, region, region.y + m - 1, offsets, threshold, ring(m) + 1, allow_avx2);
     } else if (m == region.height + 1) {
       std::fill(ring(m), ring(m) + map_w, std::uint8_t{0});
     }
   };
   produce(1);
   produce(2);
+  const bool use_avx2 = allow_avx2 && cpu_has_avx2();
+  (void)use_avx2;
   for (int r = 1; r <= region.height; ++r) {
     produce(r + 2);
+#if defined(RGBL_HAVE_AVX2_PATH)
+    if (use_avx2) {
+      suppress_row_avx2(ring(r - 1), ring(r), ring(r + 1), region, region.y + r - 1, corners);
+      continue;
+    }
+#endif
     suppress_row(ring(r - 1), ring(r), ring(r + 1), region, region.y + r - 1, corners);
   }
 }

@@ -182,10 +182,13 @@ TEST_CASE("FAST corners: the 3x3 maxima of the score map, ties to the first in r
         }
       }
     }
-    rgbl::detail::detect_fast(img, region, 7, scratch, corners);
-    for (const auto& c : corners) got.emplace_back(c.x, c.y, c.score);
-    INFO("region " << region);
-    CHECK(got == expected);
+    for (const bool avx2 : {true, false}) {
+      rgbl::detail::detect_fast(img, region, 7, scratch, corners, avx2);
+      got.clear();
+      for (const auto& c : corners) got.emplace_back(c.x, c.y, c.score);
+      INFO("region " << region << (avx2 ? " (AVX2 where the CPU has it)" : " (SSE2)"));
+      CHECK(got == expected);
+    }
     if (region.height > 100) CHECK(expected.size() > 500);
   }
 }
