@@ -120,16 +120,13 @@ __attribute__((target("avx2"))) void row_scores_avx2(const std::uint8_t* row, in
     }
     const std::uint8_t* centre = row + x;
     const __m256i c = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(centre));
-    __m256i b[16], d[16];
-    for (int k = 0; k < 16; k += 4) {
-      const __m256i p = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(centre + offsets[static_cast<std::size_t>(k)]));
-      b[k] = _mm256_subs_epu8(p, c);
-      d[k] = _mm256_subs_epu8(c, p);
-    }
+    __m256i p[16];  // the circle's pixels; the compass points first
     __m256i ge[8];
     for (int k = 0; k < 4; ++k) {
-      ge[k] = _mm256_cmpeq_epi8(_mm256_max_epu8(b[4 * k], t1), b[4 * k]);
-      ge[4 + k] = _mm256_cmpeq_epi8(_mm256_max_epu8(d[4 * k], t1), d[4 * k]);
+      p[4 * k] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(centre + offsets[static_cast<std::size_t>(4 * k)]));
+      const __m256i b = _mm256_subs_epu8(p[4 * k], c), d = _mm256_subs_epu8(c, p[4 * k]);
+      ge[k] = _mm256_cmpeq_epi8(_mm256_max_epu8(b, t1), b);
+      ge[4 + k] = _mm256_cmpeq_epi8(_mm256_max_epu8(d, t1), d);
     }
     __m256i possible = _mm256_setzero_si256();
     for (int k = 0; k < 4; ++k) {
@@ -144,8 +141,8 @@ __attribute__((target("avx2"))) void row_scores_avx2(const std::uint8_t* row, in
       // p - c)+, and the min of (c - p)+ is (c - max over the arc of p)+, so the brightest arc's
       // minimum and the darkest arc's maximum give the score with two subtractions in all. Two windows
       // of 9 at a time as in block_scores (odd starts only).
-      __m256i p[16];
       for (int k = 0; k < 16; ++k) {
+        if (k % 4 == 0) continue;
         p[k] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(centre + offsets[static_cast<std::size_t>(k)]));
       }
       __m256i lo2[16], lo4[16], hi2[16], hi4[16];
