@@ -18,7 +18,10 @@ void rotate_pattern(std::span<const float> soa, float sa, float ca, int step, st
                     bool allow_avx2 = true);
 
 // The 256 tests of a descriptor around `centre`: bit i (bit i % 8 of byte i / 8) is set where
-// centre[offsets[i]] < centre[offsets[n + i]], n = offsets.size() / 2 >= 256.
-void brief_bits(const std::uint8_t* centre, std::span<const int> offsets, std::uint8_t* out32);
+// centre[offsets[i]] < centre[offsets[n + i]], n = offsets.size() / 2 >= 256. The AVX2 path reads
+// whole 32-bit words, so 3 bytes after every sampled pixel must be readable (the extractor's
+// keypoints keep edge_threshold > patch_size / 2 from the borders, so they lie in the image).
+void brief_bits(const std::uint8_t* centre, std::span<const int> offsets, std::uint8_t* out32,
+                bool allow_avx2 = true);
 
 }  // namespace rgbl::detail

@@ -369,8 +369,10 @@ TEST_CASE("BRIEF kernels: AVX2, SSE2 and the plain formula give the same offsets
     REQUIRE(without == plain);
     // the tests on a 200 x 200 image with stride 200: offsets again for that stride
     rgbl::detail::rotate_pattern(soa, sa, ca, static_cast<int>(img.step1()), with_avx2);
-    std::array<std::uint8_t, 32> bits{};
+    std::array<std::uint8_t, 32> bits{}, bits_sse2{};
     rgbl::detail::brief_bits(centre, with_avx2, bits.data());
+    rgbl::detail::brief_bits(centre, with_avx2, bits_sse2.data(), false);
+    REQUIRE(bits == bits_sse2);
     for (std::size_t t = 0; t < 256; ++t) {
       const bool expected = centre[with_avx2[t]] < centre[with_avx2[n + t]];
       REQUIRE((((bits[t / 8] >> (t % 8)) & 1U) != 0) == expected);
