@@ -29,7 +29,8 @@ inline __m128 round_away_sse2(__m128 v) {
 #if defined(RGBL_HAVE_AVX2_PATH)
 __attribute__((target("avx2"))) inline __m256 round_away_avx2(__m256 v) {
   const __m256 half = _mm256_set1_ps(0.5F), sign = _mm256_set1_ps(-0.0F);
-  return _mm256_cvtepi32_ps(_mm256_cvttps_epi32(_mm256_add_ps(v, _mm256_or_ps(half, _mm256_and_ps(v, sign)))));
+  // truncation in float (the same as to int and back for these small values)
+  return _mm256_round_ps(_mm256_add_ps(v, _mm256_or_ps(half, _mm256_and_ps(v, sign))), _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
 }
 
 // 8 pairs at a time; returns how many pairs it did.

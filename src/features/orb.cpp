@@ -338,8 +338,6 @@ void OrbExtractor::distribute(int target, Level& level) {
     for (std::size_t q = 1; q < 4; ++q) fill[q] = fill[q - 1] + static_cast<std::size_t>(count[q - 1]);
     const std::array<std::size_t, 4> start = fill;
     for (std::size_t i = first; i < last; ++i) scratch[fill[quadrant(candidates[i])]++] = candidates[i];
-    std::copy(scratch.begin() + static_cast<std::ptrdiff_t>(first), scratch.begin() + static_cast<std::ptrdiff_t>(last),
-              candidates.begin() + static_cast<std::ptrdiff_t>(first));
     const auto index = [](std::size_t i) { return static_cast<int>(i); };
     const Node children[4] = {{node.x0, node.y0, xm, ym, index(start[0]), index(start[1])},
                               {xm, node.y0, node.x1, ym, index(start[1]), index(start[2])},
@@ -348,6 +346,12 @@ void OrbExtractor::distribute(int target, Level& level) {
     for (const Node& c : children) {
       if (c.end > c.begin) out.push_back(c);
     }
+  };
+  // A round writes every node's corners into the scratch at the same positions (split nodes by
+  // quadrant, the others as they are), then the two buffers swap.
+  auto carry_over = [&](const Node& node, std::vector<Node>& out) {
+    std::copy(candidates.begin() + node.begin, candidates.begin() + node.end, scratch.begin() + node.begin);
+    out.push_back(node);
   };
   for (;;) {
     if (static_cast<int>(nodes.size()) >= target_nodes) break;
@@ -359,10 +363,11 @@ void OrbExtractor::distribute(int target, Level& level) {
         if (splittable(node)) {
           split(node, next_nodes);
         } else {
-          next_nodes.push_back(node);
+          carry_over(node, next_nodes);
         }
       }
       nodes.swap(next_nodes);
+      candidates.swap(scratch);
       continue;
     }
     // Last round: split the most populated nodes first, stopping as soon as the target is reached.
@@ -376,11 +381,12 @@ void OrbExtractor::distribute(int target, Level& level) {
       if (splittable(nodes[i])) {
         split(nodes[i], next_nodes);
       } else {
-        next_nodes.push_back(nodes[i]);
+        carry_over(nodes[i], next_nodes);
       }
     }
-    for (; i < nodes.size(); ++i) next_nodes.push_back(nodes[i]);
+    for (; i < nodes.size(); ++i) carry_over(nodes[i], next_nodes);
     nodes.swap(next_nodes);
+    candidates.swap(scratch);
   }
   const auto stronger = [](const Candidate& a, const Candidate& b) {
     if (a.response != b.response) return a.response > b.response;
