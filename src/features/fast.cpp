@@ -171,6 +171,67 @@ __attribute__((target("avx2"))) void row_scores_avx2(const std::uint8_t* row, in
 
 #endif
 
+#if defined(RGBL_HAVE_AVX2_PATH)
+// The same as row_scores_avx2 on 64 pixels per step with AVX-512BW (compares give bit masks).
+__attribute__((target("avx512bw"))) void row_scores_avx512(const std::uint8_t* row, int begin, int end,
+                                                           const std::array<int, 16>& offsets, int threshold,
+                                                           std::uint8_t* out) {
+  const __m512i t1 = _mm512_set1_epi8(static_cast<char>(threshold + 1));
+  const __m512i one = _mm512_set1_epi8(1);
+  int x = begin;
+  for (;;) {
+    if (x + 64 > end) {
+      if (x == end) break;
+      x = end - 64;  // the tail as one overlapping block
+    }
+    const std::uint8_t* centre = row + x;
+    const __m512i c = _mm512_loadu_si512(centre);
+    __m512i p[16];
+    __mmask64 ge[8];
+    for (int k = 0; k < 4; ++k) {
+      p[4 * k] = _mm512_loadu_si512(centre + offsets[static_cast<std::size_t>(4 * k)]);
+      ge[k] = _mm512_cmpge_epu8_mask(_mm512_subs_epu8(p[4 * k], c), t1);
+      ge[4 + k] = _mm512_cmpge_epu8_mask(_mm512_subs_epu8(c, p[4 * k]), t1);
+    }
+    __mmask64 possible = 0;
+    for (int k = 0; k < 4; ++k) possible |= (ge[k] & ge[(k + 1) & 3]) | (ge[4 + k] & ge[4 + ((k + 1) & 3)]);
+    std::uint8_t* dst = out + (x - begin);
+    if (possible == 0) {
+      _mm512_storeu_si512(dst, _mm512_setzero_si512());
+    } else {
+      for (int k = 0; k < 16; ++k) {
+        if (k % 4 == 0) continue;
+        p[k] = _mm512_loadu_si512(centre + offsets[static_cast<std::size_t>(k)]);
+      }
+      __m512i lo2[16], lo4[16], hi2[16], hi4[16];
+      for (int j = 1; j < 16; j += 2) {
+        lo2[j] = _mm512_min_epu8(p[j], p[(j + 1) & 15]);
+        hi2[j] = _mm512_max_epu8(p[j], p[(j + 1) & 15]);
+      }
+      for (int j = 1; j < 16; j += 2) {
+        lo4[j] = _mm512_min_epu8(lo2[j], lo2[(j + 2) & 15]);
+        hi4[j] = _mm512_max_epu8(hi2[j], hi2[(j + 2) & 15]);
+      }
+      __m512i brightest = _mm512_setzero_si512(), darkest = _mm512_set1_epi8(static_cast<char>(0xFF));
+      for (int k = 0; k < 16; k += 2) {
+        const __m512i lo8 = _mm512_min_epu8(lo4[k + 1], lo4[(k + 5) & 15]);
+        const __m512i hi8 = _mm512_max_epu8(hi4[k + 1], hi4[(k + 5) & 15]);
+        brightest = _mm512_max_epu8(brightest, _mm512_min_epu8(lo8, _mm512_max_epu8(p[k], p[(k + 9) & 15])));
+        darkest = _mm512_min_epu8(darkest, _mm512_max_epu8(hi8, _mm512_min_epu8(p[k], p[(k + 9) & 15])));
+      }
+      const __m512i best = _mm512_max_epu8(_mm512_subs_epu8(brightest, c), _mm512_subs_epu8(c, darkest));
+      _mm512_storeu_si512(dst, _mm512_maskz_subs_epu8(_mm512_cmpge_epu8_mask(best, t1), best, one));
+    }
+    x += 64;
+  }
+}
+
+bool cpu_has_avx512bw() {
+  static const bool has = __builtin_cpu_supports("avx512bw") != 0;
+  return has;
+}
+#endif
+
 }  // namespace
 
 bool cpu_has_avx2() {
@@ -200,6 +261,10 @@ void score_row(const cv::Mat& img, cv::Rect region, int y, const std::array<int,
 #if !defined(RGBL_HAVE_AVX2_PATH)
   (void)allow_avx2;
 #else
+  if (allow_avx2 && region.width >= 64 && cpu_has_avx512bw()) {
+    row_scores_avx512(row, x, end, offsets, threshold, out);
+    return;
+  }
   if (allow_avx2 && region.width >= 32 && cpu_has_avx2()) {
     row_scores_avx2(row, x, end, offsets, threshold, out);
     return;
@@ -243,6 +308,29 @@ __attribute__((target("avx2"))) void suppress_row_avx2(const std::uint8_t* up, c
     if (region.width - x + 1 < 32) mask &= (1U << static_cast<unsigned>(region.width - x + 1)) - 1U;
     while (mask != 0) {
       const int bit = __builtin_ctz(mask);
+      mask &= mask - 1U;
+      corners.push_back({region.x + x + bit - 1, y, mid[x + bit]});
+    }
+  }
+}
+#endif
+
+#if defined(RGBL_HAVE_AVX2_PATH)
+// suppress_row on 64 map entries per step with AVX-512BW (the rows need 64 readable bytes of padding).
+__attribute__((target("avx512bw"))) void suppress_row_avx512(const std::uint8_t* up, const std::uint8_t* mid,
+                                                             const std::uint8_t* down, cv::Rect region, int y,
+                                                             std::vector<FastCorner>& corners) {
+  for (int x = 1; x <= region.width; x += 64) {
+    const __m512i s = _mm512_loadu_si512(mid + x);
+    auto mask = static_cast<std::uint64_t>(_mm512_test_epi8_mask(s, s));  // nonzero entries
+    if (mask == 0) continue;
+    mask &= _mm512_cmpgt_epu8_mask(s, _mm512_loadu_si512(up + x - 1)) & _mm512_cmpgt_epu8_mask(s, _mm512_loadu_si512(up + x)) &
+            _mm512_cmpgt_epu8_mask(s, _mm512_loadu_si512(up + x + 1)) & _mm512_cmpgt_epu8_mask(s, _mm512_loadu_si512(mid + x - 1)) &
+            _mm512_cmpge_epu8_mask(s, _mm512_loadu_si512(mid + x + 1)) & _mm512_cmpge_epu8_mask(s, _mm512_loadu_si512(down + x - 1)) &
+            _mm512_cmpge_epu8_mask(s, _mm512_loadu_si512(down + x)) & _mm512_cmpge_epu8_mask(s, _mm512_loadu_si512(down + x + 1));
+    if (region.width - x + 1 < 64) mask &= (std::uint64_t{1} << static_cast<unsigned>(region.width - x + 1)) - 1U;
+    while (mask != 0) {
+      const int bit = __builtin_ctzll(mask);
       mask &= mask - 1U;
       corners.push_back({region.x + x + bit - 1, y, mid[x + bit]});
     }
@@ -311,7 +399,7 @@ void detect_fast(const cv::Mat& img, cv::Rect region, int threshold, std::vector
   // instead of writing and re-reading a map of the whole level; scoring runs two rows ahead, so no
   // row is read right after it was written (its unaligned reads would wait on the stores).
   const auto map_w = static_cast<std::size_t>(region.width) + 2;
-  scores.assign(4 * map_w + 32, 0);
+  scores.assign(4 * map_w + 64, 0);
   const auto offsets = circle_offsets(img);
   const auto ring = [&](int map_row) { return scores.data() + static_cast<std::size_t>(map_row % 4) * map_w; };
   // map row m holds image row region.y + m - 1; rows 0 and height + 1 are zero
@@ -326,9 +414,16 @@ void detect_fast(const cv::Mat& img, cv::Rect region, int threshold, std::vector
   produce(2);
   const bool use_avx2 = allow_avx2 && cpu_has_avx2();
   (void)use_avx2;
+#if defined(RGBL_HAVE_AVX2_PATH)
+  const bool use_avx512 = allow_avx2 && cpu_has_avx512bw();
+#endif
   for (int r = 1; r <= region.height; ++r) {
     produce(r + 2);
 #if defined(RGBL_HAVE_AVX2_PATH)
+    if (use_avx512) {
+      suppress_row_avx512(ring(r - 1), ring(r), ring(r + 1), region, region.y + r - 1, corners);
+      continue;
+    }
     if (use_avx2) {
       suppress_row_avx2(ring(r - 1), ring(r), ring(r + 1), region, region.y + r - 1, corners);
       continue;

@@ -126,7 +126,8 @@ TEST_CASE("FAST scores: the same corner set as cv::FAST at every threshold", "[f
     CHECK(ours.size() > 500);
     CHECK(ours == theirs);
   }
-  // Every code path (AVX2 32-wide, SSE2 16-wide, scalar tails and narrow regions) gives the same map.
+  // Every code path (AVX-512BW 64-wide, AVX2 32-wide, SSE2 16-wide, scalar tails and narrow regions)
+  // gives the same map.
   std::vector<std::uint8_t> other;
   for (const int width : {5, 12, 16, 20, 31, 40, 77, img.cols - 6}) {
     const cv::Rect r(3, 3, width, img.rows - 6);
@@ -186,7 +187,7 @@ TEST_CASE("FAST corners: the 3x3 maxima of the score map, ties to the first in r
       rgbl::detail::detect_fast(img, region, 7, scratch, corners, avx2);
       got.clear();
       for (const auto& c : corners) got.emplace_back(c.x, c.y, c.score);
-      INFO("region " << region << (avx2 ? " (AVX2 where the CPU has it)" : " (SSE2)"));
+      INFO("region " << region << (avx2 ? " (AVX-512 or AVX2 where the CPU has them)" : " (SSE2)"));
       CHECK(got == expected);
     }
     if (region.height > 100) CHECK(expected.size() > 500);
