@@ -254,18 +254,18 @@ std::array<int, 16> circle_offsets(const cv::Mat& img) {
 
 // Scores of image row y over the region's columns into out[0, region.width).
 void score_row(const cv::Mat& img, cv::Rect region, int y, const std::array<int, 16>& offsets, int threshold,
-               std::uint8_t* out, bool allow_avx2) {
+               std::uint8_t* out, SimdWidth widest) {
   const std::uint8_t* row = img.ptr<std::uint8_t>(y);
   int x = region.x;
   const int end = region.x + region.width;
 #if !defined(RGBL_HAVE_AVX2_PATH)
-  (void)allow_avx2;
+  (void)widest;
 #else
-  if (allow_avx2 && region.width >= 64 && cpu_has_avx512bw()) {
+  if (widest == SimdWidth::avx512 && region.width >= 64 && cpu_has_avx512bw()) {
     row_scores_avx512(row, x, end, offsets, threshold, out);
     return;
   }
-  if (allow_avx2 && region.width >= 32 && cpu_has_avx2()) {
+  if (widest != SimdWidth::sse2 && region.width >= 32 && cpu_has_avx2()) {
     row_scores_avx2(row, x, end, offsets, threshold, out);
     return;
   }
@@ -380,19 +380,19 @@ void suppress_row(const std::uint8_t* up, const std::uint8_t* mid, const std::ui
 }  // namespace
 
 void fast_score_map(const cv::Mat& img, cv::Rect region, int threshold, std::vector<std::uint8_t>& scores,
-                    bool allow_avx2) {
+                    SimdWidth widest) {
   const int map_w = region.width + 2;
   // 16 bytes of padding let the non-maximum pass read whole 16-byte blocks at the end of the map.
   scores.assign(static_cast<std::size_t>(map_w) * static_cast<std::size_t>(region.height + 2) + 16, 0);
   const auto offsets = circle_offsets(img);
   for (int y = region.y; y < region.y + region.height; ++y) {
     std::uint8_t* out = scores.data() + static_cast<std::size_t>(y - region.y + 1) * static_cast<std::size_t>(map_w) + 1;
-    score_row(img, region, y, offsets, threshold, out, allow_avx2);
+    score_row(img, region, y, offsets, threshold, out, widest);
   }
 }
 
 void detect_fast(const cv::Mat& img, cv::Rect region, int threshold, std::vector<std::uint8_t>& scores,
-                 std::vector<FastCorner>& corners, bool allow_avx2) {
+                 std::vector<FastCorner>& corners, SimdWidth widest) {
   corners.clear();
   if (region.width <= 0 || region.height <= 0) return;
   // The map's rows in a ring of four, so each row is suppressed while its neighbours are still in L1,
@@ -405,17 +405,17 @@ void detect_fast(const cv::Mat& img, cv::Rect region, int threshold, std::vector
   // map row m holds image row region.y + m - 1; rows 0 and height + 1 are zero
   const auto produce = [&](int m) {
     if (m >= 1 && m <= region.height) {
-      score_row(img, region, region.y + m - 1, offsets, threshold, ring(m) + 1, allow_avx2);
+      score_row(img, region, region.y + m - 1, offsets, threshold, ring(m) + 1, widest);
     } else if (m == region.height + 1) {
       std::fill(ring(m), ring(m) + map_w, std::uint8_t{0});
     }
   };
   produce(1);
   produce(2);
-  const bool use_avx2 = allow_avx2 && cpu_has_avx2();
+  const bool use_avx2 = widest != SimdWidth::sse2 && cpu_has_avx2();
   (void)use_avx2;
 #if defined(RGBL_HAVE_AVX2_PATH)
-  const bool use_avx512 = allow_avx2 && cpu_has_avx512bw();
+  const bool use_avx512 = widest == SimdWidth::avx512 && cpu_has_avx512bw();
 #endif
   for (int r = 1; r <= region.height; ++r) {
     produce(r + 2);

@@ -131,10 +131,12 @@ TEST_CASE("FAST scores: the same corner set as cv::FAST at every threshold", "[f
   std::vector<std::uint8_t> other;
   for (const int width : {5, 12, 16, 20, 31, 40, 77, img.cols - 6}) {
     const cv::Rect r(3, 3, width, img.rows - 6);
-    rgbl::detail::fast_score_map(img, r, 7, scores, true);
-    rgbl::detail::fast_score_map(img, r, 7, other, false);
+    rgbl::detail::fast_score_map(img, r, 7, scores);
     INFO("width " << width);
-    CHECK(scores == other);
+    for (const auto widest : {rgbl::detail::SimdWidth::avx2, rgbl::detail::SimdWidth::sse2}) {
+      rgbl::detail::fast_score_map(img, r, 7, other, widest);
+      CHECK(scores == other);
+    }
     // ... and the same as the full-width map restricted to the region.
     std::vector<std::uint8_t> full;
     rgbl::detail::fast_score_map(img, region, 7, full);
@@ -183,11 +185,12 @@ TEST_CASE("FAST corners: the 3x3 maxima of the score map, ties to the first in r
         }
       }
     }
-    for (const bool avx2 : {true, false}) {
-      rgbl::detail::detect_fast(img, region, 7, scratch, corners, avx2);
+    using rgbl::detail::SimdWidth;
+    for (const auto widest : {SimdWidth::avx512, SimdWidth::avx2, SimdWidth::sse2}) {
+      rgbl::detail::detect_fast(img, region, 7, scratch, corners, widest);
       got.clear();
       for (const auto& c : corners) got.emplace_back(c.x, c.y, c.score);
-      INFO("region " << region << (avx2 ? " (AVX-512 or AVX2 where the CPU has them)" : " (SSE2)"));
+      INFO("region " << region << ", vector width up to " << static_cast<int>(widest) << " (0 SSE2, 1 AVX2, 2 AVX-512)");
       CHECK(got == expected);
     }
     if (region.height > 100) CHECK(expected.size() > 500);
