@@ -1,16 +1,9 @@
 #include "brief.hpp"
 
-#include "fast.hpp"
+#include "simd.hpp"
 
 #include <array>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
-#define RGBL_HAVE_AVX2_PATH 1
-#endif
 
 namespace rgbl::detail {
 

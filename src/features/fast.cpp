@@ -3,13 +3,6 @@
 #include <algorithm>
 #include <array>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
-#define RGBL_HAVE_AVX2_PATH 1
-#endif
 
 namespace rgbl::detail {
 
@@ -226,10 +219,6 @@ __attribute__((target("avx512bw"))) void row_scores_avx512(const std::uint8_t* r
   }
 }
 
-bool cpu_has_avx512bw() {
-  static const bool has = __builtin_cpu_supports("avx512bw") != 0;
-  return has;
-}
 #endif
 
 }  // namespace
@@ -237,6 +226,15 @@ bool cpu_has_avx512bw() {
 bool cpu_has_avx2() {
 #if defined(RGBL_HAVE_AVX2_PATH)
   static const bool has = __builtin_cpu_supports("avx2") != 0;
+  return has;
+#else
+  return false;
+#endif
+}
+
+bool cpu_has_avx512bw() {
+#if defined(RGBL_HAVE_AVX2_PATH)
+  static const bool has = __builtin_cpu_supports("avx512bw") != 0;
   return has;
 #else
   return false;

@@ -3,6 +3,7 @@
 // non-maximum suppression, written for one pass per pyramid level at the lowest threshold.
 
 #include "rgbl/features/orb.hpp"
+#include "simd.hpp"
 
 #include <opencv2/core/mat.hpp>
 
@@ -13,12 +14,6 @@ namespace rgbl::detail {
 
 // FastCorner (rgbl/features/orb.hpp): score = largest threshold t at which the pixel is a corner
 // (p > c + t or p < c - t on a 9-arc).
-
-// The widest vector path a kernel may take (it takes the widest the CPU has, up to this).
-enum class SimdWidth { sse2, avx2, avx512 };
-
-// Whether this CPU runs the AVX2 paths (compiled per function, chosen at run time).
-bool cpu_has_avx2();
 
 // Score map over `region` (every pixel of it must be >= 3 px inside `img`): score[(y - region.y + 1)
 // * (region.width + 2) + (x - region.x + 1)] is the pixel's FAST score if it is a corner at

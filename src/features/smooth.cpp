@@ -1,6 +1,6 @@
 #include "smooth.hpp"
 
-#include "fast.hpp"
+#include "simd.hpp"
 
 #include <opencv2/imgproc.hpp>
 
@@ -9,10 +9,6 @@
 #include <cstring>
 #include <vector>
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
-#define RGBL_HAVE_AVX2_PATH 1
-#endif
 
 namespace rgbl::detail {
 

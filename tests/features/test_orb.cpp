@@ -103,6 +103,19 @@ WarpResult evaluate_warp(const cv::Mat& a, const cv::Mat& b, const cv::Matx23d& 
   return r;
 }
 
+// The textured scene through a default extractor, kept for its pyramid.
+struct TexturedExtraction {
+  rgbl::OrbExtractor extractor;
+  std::vector<rgbl::Keypoint> keypoints;
+  std::vector<rgbl::Descriptor> descriptors;
+};
+
+TexturedExtraction extract_textured() {
+  TexturedExtraction e;
+  e.extractor.extract(textured_image(1226, 370), e.keypoints, e.descriptors);
+  return e;
+}
+
 }  // namespace
 
 TEST_CASE("FAST scores: the same corner set as cv::FAST at every threshold", "[features][orb]") {
@@ -269,11 +282,7 @@ TEST_CASE("ORB: exact feature count, levels, borders and budgets on a real frame
 }
 
 TEST_CASE("ORB: orientation is the intensity centroid angle over the radius-15 disc", "[features][orb]") {
-  const cv::Mat img = textured_image(1226, 370);
-  rgbl::OrbExtractor extractor;
-  std::vector<rgbl::Keypoint> kps;
-  std::vector<rgbl::Descriptor> desc;
-  extractor.extract(img, kps, desc);
+  const auto [extractor, kps, desc] = extract_textured();
   REQUIRE(kps.size() == 2000);
   for (std::size_t i = 0; i < kps.size(); i += 7) {
     const auto& k = kps[i];
@@ -302,11 +311,7 @@ TEST_CASE("ORB: every descriptor bit is its rotated BRIEF test on the blurred le
   // The definition, written plainly: the pattern rotated by the keypoint's angle, each point rounded
   // half away from zero, bit i set where the smoothed level is darker at the first point than at the
   // second. The extractor's vectorised paths must give exactly this.
-  const cv::Mat img = textured_image(1226, 370);
-  rgbl::OrbExtractor extractor;
-  std::vector<rgbl::Keypoint> kps;
-  std::vector<rgbl::Descriptor> desc;
-  extractor.extract(img, kps, desc);
+  const auto [extractor, kps, desc] = extract_textured();
   REQUIRE(kps.size() == 2000);
   const auto pattern = rgbl::make_brief_pattern(31);
   REQUIRE(pattern.size() == 256);
