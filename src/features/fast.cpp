@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 
-
 namespace rgbl::detail {
 
 namespace {
@@ -95,7 +94,6 @@ inline void block_scores(const std::uint8_t* centre, const std::array<int, 16>& 
   _mm_storeu_si128(reinterpret_cast<__m128i*>(out), score);
 }
 #endif
-
 
 #if defined(RGBL_HAVE_AVX2_PATH)
 // The same computation as block_scores on 32 pixels per step, compiled for AVX2 only in this function
@@ -337,7 +335,7 @@ __attribute__((target("avx512bw"))) void suppress_row_avx512(const std::uint8_t*
 #endif
 
 // Appends the 3x3 maxima of map row `mid` (rows of width + 2 entries with a zero column at each end,
-// 16 entries of readable padding after) as corners of image row y.
+// 16 entries of readable padding after; detect_fast's ring has 64) as corners of image row y.
 void suppress_row(const std::uint8_t* up, const std::uint8_t* mid, const std::uint8_t* down, cv::Rect region, int y,
                   std::vector<FastCorner>& corners) {
 #if defined(__SSE2__)
@@ -380,7 +378,8 @@ void suppress_row(const std::uint8_t* up, const std::uint8_t* mid, const std::ui
 void fast_score_map(const cv::Mat& img, cv::Rect region, int threshold, std::vector<std::uint8_t>& scores,
                     SimdWidth widest) {
   const int map_w = region.width + 2;
-  // 16 bytes of padding let the non-maximum pass read whole 16-byte blocks at the end of the map.
+  // The whole level's map, for tests (detect_fast keeps only a ring of rows); 16 bytes of padding as
+  // suppress_row expects.
   scores.assign(static_cast<std::size_t>(map_w) * static_cast<std::size_t>(region.height + 2) + 16, 0);
   const auto offsets = circle_offsets(img);
   for (int y = region.y; y < region.y + region.height; ++y) {
@@ -410,10 +409,9 @@ void detect_fast(const cv::Mat& img, cv::Rect region, int threshold, std::vector
   };
   produce(1);
   produce(2);
-  const bool use_avx2 = widest != SimdWidth::sse2 && cpu_has_avx2();
-  (void)use_avx2;
 #if defined(RGBL_HAVE_AVX2_PATH)
   const bool use_avx512 = widest == SimdWidth::avx512 && cpu_has_avx512bw();
+  const bool use_avx2 = widest != SimdWidth::sse2 && cpu_has_avx2();
 #endif
   for (int r = 1; r <= region.height; ++r) {
     produce(r + 2);

@@ -58,7 +58,6 @@ class SplitMix64 {
   std::uint64_t state_;
 };
 
-
 #if defined(__SSE2__)
 inline __m128i load16(const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
 
@@ -169,16 +168,17 @@ OrbExtractor::OrbExtractor(const OrbOptions& options) : options_(options) {
   }
   budgets_[static_cast<std::size_t>(levels) - 1] = std::max(0, options_.num_features - assigned);
 
-  pattern_ = make_brief_pattern(options_.patch_size);
-  pattern_soa_.resize(pattern_.size() * 4);
-  for (std::size_t i = 0, n = pattern_.size(); i < n; ++i) {
-    pattern_soa_[i] = pattern_[i].x1;
-    pattern_soa_[n + i] = pattern_[i].y1;
-    pattern_soa_[2 * n + i] = pattern_[i].x2;
-    pattern_soa_[3 * n + i] = pattern_[i].y2;
+  const std::vector<BriefPair> pattern = make_brief_pattern(options_.patch_size);
+  const std::size_t n = pattern.size();
+  pattern_soa_.resize(n * 4);
+  for (std::size_t i = 0; i < n; ++i) {
+    pattern_soa_[i] = pattern[i].x1;
+    pattern_soa_[n + i] = pattern[i].y1;
+    pattern_soa_[2 * n + i] = pattern[i].x2;
+    pattern_soa_[3 * n + i] = pattern[i].y2;
   }
   levels_.resize(static_cast<std::size_t>(levels));
-  for (auto& level : levels_) level.pattern_offsets.resize(pattern_.size() * 2);
+  for (auto& level : levels_) level.pattern_offsets.resize(n * 2);
   const int r = options_.orientation_radius;
   disc_half_width_.resize(static_cast<std::size_t>(r) + 1);
   for (int v = 0; v <= r; ++v) {

@@ -117,7 +117,8 @@ void smooth_for_brief(const cv::Mat& src, cv::Mat& dst, int size, double sigma, 
   // row between them); reflection needs 4 rows, the overlapping tail block 16 columns.
   if (allow_fast && size == 7 && sigma == 2.0 && src.type() == CV_8UC1 && src.cols >= 16 && src.rows >= 4 &&
       cpu_has_avx2()) {
-    if (dst.size() != src.size() || dst.type() != CV_8UC1 || dst.data == src.data) dst.create(src.size(), CV_8UC1);
+    if (dst.data == src.data) dst.release();  // create() would keep the shared buffer
+    dst.create(src.size(), CV_8UC1);            // no-op when dst already fits
     smooth_avx2(src, dst, padded, rows);
     return;
   }

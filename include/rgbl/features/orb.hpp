@@ -131,8 +131,7 @@ class OrbExtractor {
   OrbOptions options_;
   std::vector<float> scales_;
   std::vector<int> budgets_;
-  std::vector<BriefPair> pattern_;
-  // The same pairs as four coordinate arrays (x1..., y1..., x2..., y2...), for rotating 4 at a time.
+  // The BRIEF pairs as four coordinate arrays (x1..., y1..., x2..., y2...), for rotating several at a time.
   std::vector<float> pattern_soa_;
   std::vector<int> disc_half_width_;  // per row offset 0..radius: half width of the orientation disc
   std::vector<std::uint8_t> disc_masks_;  // the same disc as 32-byte row masks for the SIMD path
