@@ -370,6 +370,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.loop_closing.fuse = flag("LoopClosing.Fuse");
   s.loop_closing.global_ba = flag("LoopClosing.GlobalBA");
   s.loop_closing.merge_maps = flag("LoopClosing.MergeMaps");
+  s.place_culling = flag("LocalMapping.PlaceCulling");
 
   if (!(s.projection.min_depth >= 0.0F)) r.fail("LiDAR.min_dist", "a distance >= 0 m");
   if (!(s.projection.max_depth > s.projection.min_depth))

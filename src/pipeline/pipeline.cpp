@@ -78,6 +78,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (l.fuse) loop.fuse = *l.fuse;
   if (l.global_ba) loop.global_ba = *l.global_ba;
   if (l.merge_maps) loop.merge_maps = *l.merge_maps;
+  if (s.place_culling) p.system.mapping.place_culling = *s.place_culling;
   if (s.bf || s.th_depth) {
     p.notes.push_back("Camera.bf / ThDepth are not used: rgbl weights depth with an explicit noise model");
   }

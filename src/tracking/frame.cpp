@@ -86,6 +86,12 @@ void LocalMappingOptions::validate() const {
   require(max_local_ba_keyframes >= 1, "local_mapping.max_local_ba_keyframes", ">= 1");
   require(min_found_ratio >= 0.0 && min_found_ratio <= 1.0, "local_mapping.min_found_ratio", "in [0, 1]");
   require(redundant_ratio > 0.0 && redundant_ratio <= 1.0, "local_mapping.redundant_ratio", "in (0, 1]");
+  require(place_distance_ratio > 0.0 && place_distance_ratio < 1.0, "local_mapping.place_distance_ratio",
+          "a fraction of the median depth in (0, 1)");
+  require(place_angle_deg > 0.0 && place_angle_deg < 90.0, "local_mapping.place_angle_deg", "in (0, 90) degrees");
+  require(revisit_path_ratio >= 1.0, "local_mapping.revisit_path_ratio", ">= 1");
+  require(max_keyframes_per_place >= 2, "local_mapping.max_keyframes_per_place",
+          ">= 2 (the place's first keyframe and the new one)");
   fusion_match.validate();
   ba.validate();
 }

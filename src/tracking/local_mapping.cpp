@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <mutex>
 #include <map>
 #include <shared_mutex>
@@ -38,6 +39,10 @@ LocalMappingStats LocalMapper::process(KeyframeId keyframe, const std::vector<La
   if (options_.keyframe_culling) {
     std::unique_lock lock(map_.mutex());
     stats.culled_keyframes = cull_keyframes(keyframe);
+    if (options_.place_culling) {
+      stats.culled_revisited = cull_revisited(keyframe);
+      stats.culled_keyframes += stats.culled_revisited;
+    }
   }
   return stats;
 }
@@ -190,6 +195,59 @@ int LocalMapper::cull_keyframes(KeyframeId id) {
       map_.erase_keyframe(k);
       ++culled;
     }
+  }
+  return culled;
+}
+
+int LocalMapper::cull_revisited(KeyframeId id) {
+  const Keyframe* current = map_.keyframe(id);
+  if (current == nullptr) return 0;
+  std::vector<float> depths;
+  for (std::size_t i = 0; i < current->keypoints.size(); ++i) {
+    if (current->depth_sigma[i] > 0.0F) depths.push_back(current->depth[i]);
+  }
+  if (depths.empty()) return 0;
+  const auto middle = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2);
+  std::nth_element(depths.begin(), middle, depths.end());
+  const double radius = options_.place_distance_ratio * static_cast<double>(*middle);
+  const double min_cos = std::cos(options_.place_angle_deg * std::numbers::pi / 180.0);
+  const Eigen::Vector3d centre = current->center();
+  const Eigen::Vector3d axis = current->T_cam_world.linear().row(2).transpose();  // optical axis in the world
+  std::vector<KeyframeId> same_place;
+  for (const KeyframeId k : map_.best_covisible(id, 100)) {
+    const Keyframe* kf = map_.keyframe(k);
+    if (kf == nullptr || k.value >= id.value) continue;
+    if ((kf->center() - centre).norm() > radius) continue;
+    if (kf->T_cam_world.linear().row(2).transpose().dot(axis) < min_cos) continue;
+    same_place.push_back(k);
+  }
+  // A revisit, not the keyframe before on the same pass: the drive along the keyframes between them
+  // is long against the place's size. One walk back from the current keyframe gives every distance.
+  std::sort(same_place.begin(), same_place.end(), [](KeyframeId a, KeyframeId b) { return a.value > b.value; });
+  std::vector<KeyframeId> revisited;
+  double path = 0.0;
+  Eigen::Vector3d last = centre;
+  auto next = same_place.begin();
+  for (int v = id.value - 1; v >= 0 && next != same_place.end(); --v) {
+    const Keyframe* kf = map_.keyframe(KeyframeId{v});
+    if (kf == nullptr) continue;
+    path += (kf->center() - last).norm();
+    last = kf->center();
+    if (v != next->value) continue;
+    if (path >= options_.revisit_path_ratio * radius) revisited.push_back(*next);
+    ++next;
+  }
+  // The place keeps its first keyframe (the one loops were closed against, the anchor of the map
+  // there), the current one and the newest others, max_keyframes_per_place in all; the rest go. The
+  // first keyframe of the map and a map's root always stay (frames of a later map hang from a root).
+  const auto keep = static_cast<std::size_t>(options_.max_keyframes_per_place);
+  if (revisited.size() + 1 <= keep) return 0;
+  int culled = 0;
+  for (std::size_t i = keep - 2; i + 1 < revisited.size(); ++i) {  // newest first; the oldest is last
+    const Keyframe* kf = map_.keyframe(revisited[i]);
+    if (revisited[i].value == 0 || kf == nullptr || !kf->parent.valid()) continue;
+    map_.erase_keyframe(revisited[i]);
+    ++culled;
   }
   return culled;
 }

@@ -171,6 +171,16 @@ TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
              Contains("LoopClosing.GlobalBA"));
 }
 
+TEST_CASE("settings: LocalMapping.PlaceCulling switches keyframe culling by revisits", "[io][settings]") {
+  rgbl::test::TempDir tmp;
+  const auto off = rgbl::read_settings(tmp.write("off.yaml", "%YAML:1.0\nLocalMapping.PlaceCulling: 0\n"));
+  CHECK(off.place_culling == false);
+  CHECK(off.warnings.empty());
+  CHECK_FALSE(rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n")).place_culling);
+  CHECK_THAT(error_of(tmp.write("bad.yaml", "%YAML:1.0\nLocalMapping.PlaceCulling: 3\n")),
+             Contains("'LocalMapping.PlaceCulling': expected 0 (off) or 1 (on)"));
+}
+
 TEST_CASE("settings: wrong types, incomplete groups and bad values name file and key", "[io][settings][bad-input]") {
   rgbl::test::TempDir tmp;
   CHECK_THAT(error_of(tmp.write("a.yaml", replace(kRgblYaml, "LiDAR.min_dist: 5.0", "LiDAR.min_dist: \"five\""))),

@@ -71,6 +71,7 @@ struct Settings {
   std::string kernel_type;            // e.g. "Diamond"; empty when absent
   int kernel_size = 0;                // 0 when absent
   LoopClosingSettings loop_closing;
+  std::optional<bool> place_culling;  // LocalMapping.PlaceCulling: keyframe culling by revisits
   std::vector<std::string> warnings;  // unknown keys, one message each
 };
 

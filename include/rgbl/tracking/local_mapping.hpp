@@ -16,7 +16,8 @@ struct LocalMappingStats {
   int new_landmarks = 0;
   int culled_landmarks = 0;
   int fused_landmarks = 0;
-  int culled_keyframes = 0;
+  int culled_keyframes = 0;  // both rules together
+  int culled_revisited = 0;  // of those, by revisit (LocalMappingOptions::place_culling)
   int ba_outliers = 0;
   double ba_ms = 0.0;
 };
@@ -45,6 +46,7 @@ class LocalMapper {
   int fuse(KeyframeId keyframe);
   int local_bundle_adjustment(KeyframeId keyframe, double& elapsed_ms);
   int cull_keyframes(KeyframeId keyframe);
+  int cull_revisited(KeyframeId keyframe);
 
   Map& map_;
   PinholeCamera camera_;

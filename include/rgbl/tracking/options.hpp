@@ -166,6 +166,16 @@ struct LocalMappingOptions {
   int min_observations = 3;             // landmark culling after 2 keyframes
   double redundant_ratio = 0.9;         // keyframe culling
   int redundant_observers = 3;
+  // Keyframe culling by revisits. A place of a new keyframe: camera centres within place_distance_ratio
+  // of its median keypoint depth and viewing directions within place_angle_deg, reached again after a
+  // drive (along the keyframes) of at least revisit_path_ratio times that distance. A place keeps its
+  // first keyframe, the new one and the newest others, max_keyframes_per_place in all. Redundancy by
+  // observers alone lets a drive that passes a place again and again add keyframes on every pass.
+  bool place_culling = true;
+  int max_keyframes_per_place = 2;
+  double place_distance_ratio = 0.1;
+  double place_angle_deg = 10.0;
+  double revisit_path_ratio = 3.0;
   bool local_ba = true;
   bool keyframe_culling = true;
   bool fusion = true;
