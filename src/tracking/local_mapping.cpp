@@ -231,8 +231,9 @@ int LocalMapper::cull_revisited(KeyframeId id) {
   for (int v = id.value - 1; v >= 0 && next != same_place.end(); --v) {
     const Keyframe* kf = map_.keyframe(KeyframeId{v});
     if (kf == nullptr) continue;
-    path += (kf->center() - last).norm();
-    last = kf->center();
+    const Eigen::Vector3d c = kf->center();
+    path += (c - last).norm();
+    last = c;
     if (v != next->value) continue;
     if (path >= options_.revisit_path_ratio * radius) revisited.push_back(*next);
     ++next;
@@ -244,8 +245,8 @@ int LocalMapper::cull_revisited(KeyframeId id) {
   if (revisited.size() + 1 <= keep) return 0;
   int culled = 0;
   for (std::size_t i = keep - 2; i + 1 < revisited.size(); ++i) {  // newest first; the oldest is last
-    const Keyframe* kf = map_.keyframe(revisited[i]);
-    if (revisited[i].value == 0 || kf == nullptr || !kf->parent.valid()) continue;
+    // found in the map by the walk above; erasing others does not remove it
+    if (revisited[i].value == 0 || !map_.keyframe(revisited[i])->parent.valid()) continue;
     map_.erase_keyframe(revisited[i]);
     ++culled;
   }

@@ -15,22 +15,18 @@ struct Pose {
   double yaw_deg = 0.0;  // about the camera's y axis; 0 looks along +z
 };
 
+struct Mapped {
+  std::vector<int> ids;  // the keyframes still in the map
+  int culled_revisited = 0;
+};
+
 // Keyframes at the given poses, all observing exact landmarks on the plane z = 10 m (so a camera
 // looking along +z has every keypoint depth 10 m, and the place radius is 1 m at the defaults); then
 // local mapping of the last keyframe with only the revisit rule able to cull (ORB-SLAM's redundancy
-// rule is switched off by a ratio it cannot exceed). Returns the ids still in the map.
-std::vector<int> keyframes_after_mapping(const std::vector<Pose>& poses, rgbl::LocalMappingOptions options,
-                                         int* culled = nullptr) {
-  rgbl::test::PointsMap s = rgbl::test::make_points_map(0, 0);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> x(-3.0, 9.0), y(-2.0, 2.0);
-  std::uniform_int_distribution<int> byte(0, 255);
-  for (int i = 0; i < 400; ++i) {
-    s.points.emplace_back(x(rng), y(rng), 10.0);
-    rgbl::Descriptor d{};
-    for (auto& b : d) b = static_cast<std::uint8_t>(byte(rng));
-    s.descriptors.push_back(d);
-  }
+// rule is switched off by a ratio it cannot exceed).
+Mapped keyframes_after_mapping(const std::vector<Pose>& poses, rgbl::LocalMappingOptions options) {
+  rgbl::test::PointsMap s = rgbl::test::make_points_map(0, 400, 11);
+  for (Eigen::Vector3d& p : s.points) p.z() = 10.0;
   for (const Pose& p : poses) {
     Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
     T_world_cam.linear() = Eigen::AngleAxisd(p.yaw_deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitY()).matrix();
@@ -55,11 +51,10 @@ std::vector<int> keyframes_after_mapping(const std::vector<Pose>& poses, rgbl::L
   options.max_new_depth_points = 0;
   rgbl::LocalMapper mapper(map, s.camera, options);
   const rgbl::LocalMappingStats stats = mapper.process(map.last_keyframe_id());
-  if (culled != nullptr) *culled = stats.culled_revisited;
   CHECK(stats.culled_keyframes == stats.culled_revisited);
-  std::vector<int> ids;
-  for (const rgbl::KeyframeId id : map.keyframe_ids()) ids.push_back(id.value);
-  return ids;
+  Mapped out{{}, stats.culled_revisited};
+  for (const rgbl::KeyframeId id : map.keyframe_ids()) out.ids.push_back(id.value);
+  return out;
 }
 
 }  // namespace
@@ -69,31 +64,30 @@ TEST_CASE("revisit culling: a place passed three times keeps its first keyframe 
   // and 5 are 0.2 and 0.1 m from keyframe 7, after drives of 8.9 and 5.5 m along the keyframes
   // (>= 3 x the 1 m radius); keyframe 2 (x = 3) is 1.3 m away.
   const std::vector<Pose> three_passes = {{0.0}, {1.5}, {3.0}, {4.5}, {6.0}, {1.6}, {4.4}, {1.7}};
-  int culled = -1;
-  CHECK(keyframes_after_mapping(three_passes, rgbl::LocalMappingOptions{}, &culled) ==
-        std::vector<int>{0, 1, 2, 3, 4, 6, 7});
-  CHECK(culled == 1);
+  const Mapped mapped = keyframes_after_mapping(three_passes, rgbl::LocalMappingOptions{});
+  CHECK(mapped.ids == std::vector<int>{0, 1, 2, 3, 4, 6, 7});
+  CHECK(mapped.culled_revisited == 1);
   // Three per place: all stay.
   rgbl::LocalMappingOptions three;
   three.max_keyframes_per_place = 3;
-  CHECK(keyframes_after_mapping(three_passes, three) == std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7});
+  CHECK(keyframes_after_mapping(three_passes, three).ids == std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7});
   // Two passes: the place holds two keyframes, both stay.
-  CHECK(keyframes_after_mapping({{0.0}, {1.5}, {3.0}, {4.5}, {6.0}, {1.7}}, rgbl::LocalMappingOptions{}) ==
+  CHECK(keyframes_after_mapping({{0.0}, {1.5}, {3.0}, {4.5}, {6.0}, {1.7}}, rgbl::LocalMappingOptions{}).ids ==
         std::vector<int>{0, 1, 2, 3, 4, 5});
   // Switched off, the three passes keep every keyframe.
   rgbl::LocalMappingOptions off;
   off.place_culling = false;
-  CHECK(keyframes_after_mapping(three_passes, off) == std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7});
+  CHECK(keyframes_after_mapping(three_passes, off).ids == std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7});
 }
 
 TEST_CASE("revisit culling: the same place seen in another direction, or the keyframes just before, stay") {
   // Keyframe 5 at the place but turned by 20 deg (beyond place_angle_deg 10); at 5 deg it goes.
   CHECK(keyframes_after_mapping({{0.0}, {1.5}, {3.0}, {4.5}, {6.0}, {1.6, 20.0}, {4.4}, {1.7}},
-                                rgbl::LocalMappingOptions{}) == std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7});
+                                rgbl::LocalMappingOptions{}).ids == std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7});
   CHECK(keyframes_after_mapping({{0.0}, {1.5}, {3.0}, {4.5}, {6.0}, {1.6, 5.0}, {4.4}, {1.7}},
-                                rgbl::LocalMappingOptions{}) == std::vector<int>{0, 1, 2, 3, 4, 6, 7});
+                                rgbl::LocalMappingOptions{}).ids == std::vector<int>{0, 1, 2, 3, 4, 6, 7});
   // A slow drive: keyframes 0.4 m apart are within the radius but only 0.4-0.8 m of driving back.
-  CHECK(keyframes_after_mapping({{0.0}, {0.4}, {0.8}, {1.2}, {1.6}, {2.0}}, rgbl::LocalMappingOptions{}) ==
+  CHECK(keyframes_after_mapping({{0.0}, {0.4}, {0.8}, {1.2}, {1.6}, {2.0}}, rgbl::LocalMappingOptions{}).ids ==
         std::vector<int>{0, 1, 2, 3, 4, 5});
 }
 
