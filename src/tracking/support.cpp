@@ -38,8 +38,8 @@ StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry
   const Eigen::AngleAxisd relative(T_cam_world.linear() * T_cam_world_predicted.linear().transpose());
   check.rotation_deg = std::abs(relative.angle()) * 180.0 / std::numbers::pi;
   check.allowed_translation_m = allowed_step(predicted_step_m, dt, options);
-  check.plausible = check.translation_m <= check.allowed_translation_m &&
-                    check.rotation_deg <= options.step_tolerance_rotation_deg;
+  check.translation_plausible = check.translation_m <= check.allowed_translation_m;
+  check.plausible = check.translation_plausible && check.rotation_deg <= options.step_tolerance_rotation_deg;
   return check;
 }
 

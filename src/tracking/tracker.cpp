@@ -319,9 +319,10 @@ std::optional<Eigen::Isometry3d> Tracker::lidar_start(std::optional<LidarView>& 
 Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const {
   // Never take silently a step that a vehicle cannot make. The local map is searched from the
   // prediction first: when it places the frame within a vehicle's reach on the support of an ok frame,
-  // that pose wins, however many points agree on the implausible one (they are then on something
-  // moving with the camera, e.g. a truck alongside at the ego speed). Else the step is taken on the
-  // evidence a relocalisation needs (and reported as a jump), else the frame keeps the prediction.
+  // that pose wins over a step too far in translation, however many points agree on it (they are then
+  // on something moving with the camera, e.g. a truck alongside at the ego speed); over a step off in
+  // rotation alone only with more support. Else the step is taken on the evidence a relocalisation
+  // needs (and reported as a jump), else the frame keeps the prediction.
   const double dt = h.frame.timestamp - last_frame_->timestamp;
   const double predicted_step =
       (prediction.T_cam_world.inverse().translation() - prediction.T_last_world.inverse().translation()).norm();
@@ -343,7 +344,13 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   // No LiDAR say here: its vote judges the motion from the last frame, and a step off the prediction
   // is often the local map correcting the last frames' error (lead-vehicle seed 3, frame 47: the step
   // undid frame 46's 0.9 deg and 0.3 m, and the LiDAR voted 1421 to 25 for keeping them).
-  if (!plausible_alternative && h.inliers >= options_.min_jump_inliers && !h.weak) {
+  // Something moving in view shifts a pose locked on it by its own displacement over the frame time,
+  // metres at traffic speed, while the whole scene, far points included, cannot fake a turn: a step
+  // off the prediction in rotation only is the camera turning harder than constant velocity expects
+  // (a corner), and there the better supported pose wins.
+  const bool turn_only = step.translation_plausible;
+  const bool strongest = !plausible_alternative || (turn_only && h.inliers > from_prediction.inliers);
+  if (strongest && h.inliers >= options_.min_jump_inliers && !h.weak) {
     h.jump = true;
     logger()->warn("frame {}: step {:.2f} m / {:.1f} deg off the constant-velocity prediction (allowed {:.2f} m), "
                    "taken on {} inliers", h.frame.index, step.translation_m, step.rotation_deg,

@@ -59,6 +59,10 @@ TEST_CASE("support: a step is plausible within pose noise, velocity error and 1 
   CHECK(at(0.0, 1.3, 2.9).plausible);
   CHECK_FALSE(at(0.0, 1.3, 3.1).plausible);
   CHECK(at(0.0, 1.3, 3.1).rotation_deg == Approx(3.1));
+  // a turn harder than predicted leaves the centre within reach; a step too long does not
+  CHECK(at(0.0, 1.3, 3.1).translation_plausible);
+  CHECK_FALSE(at(0.0, 1.3 + allowed + 0.01).translation_plausible);
+  CHECK_FALSE(at(0.0, 1.3 + allowed + 0.01, 3.1).translation_plausible);
   // a frame that comes late (dropped frames) may deviate more: the acceleration term grows with dt^2
   const auto late = rgbl::check_step(camera_at(0.0, 1.3 + 0.6), predicted, 1.3, 0.3, options);
   CHECK(late.allowed_translation_m == Approx(0.25 + 0.13 + 0.45));

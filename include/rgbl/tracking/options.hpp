@@ -111,7 +111,8 @@ struct TrackerOptions {
   // from the constant-velocity prediction by step_tolerance + step_tolerance_relative * |predicted step|
   // + max_acceleration * dt^2 / 2 (two pose estimates' noise, the velocity's own error, and a change of
   // speed within a car's reach) and step_tolerance_rotation_deg. For a larger step the local map is
-  // searched from the prediction: a plausible pose found there with an ok frame's support wins. Else
+  // searched from the prediction: a plausible pose found there with an ok frame's support wins (over
+  // a step off in rotation alone, with the centre within reach, only when better supported). Else
   // the step is taken with min_jump_inliers (what a relocalisation needs) and reported as a jump;
   // otherwise the frame is weak and placed at the prediction.
   bool check_steps = true;

@@ -41,6 +41,7 @@ struct StepCheck {
   double translation_m = 0.0;    // distance between the two camera centres
   double rotation_deg = 0.0;     // angle of the relative rotation
   double allowed_translation_m = 0.0;
+  bool translation_plausible = true;  // the centre within reach (the rotation may still be off)
   bool plausible = true;
 };
 
