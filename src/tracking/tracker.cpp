@@ -344,12 +344,11 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   // No LiDAR say here: its vote judges the motion from the last frame, and a step off the prediction
   // is often the local map correcting the last frames' error (lead-vehicle seed 3, frame 47: the step
   // undid frame 46's 0.9 deg and 0.3 m, and the LiDAR voted 1421 to 25 for keeping them).
-  // Something moving in view shifts a pose locked on it by its own displacement over the frame time,
-  // metres at traffic speed, while the whole scene, far points included, cannot fake a turn: a step
-  // off the prediction in rotation only is the camera turning harder than constant velocity expects
-  // (a corner), and there the better supported pose wins.
-  const bool turn_only = step.translation_plausible;
-  const bool strongest = !plausible_alternative || (turn_only && h.inliers > from_prediction.inliers);
+  // A turn is judged on support: something moving in view shifts a pose locked on it by its own
+  // displacement (metres at traffic speed) but cannot turn the whole scene, far points included; a
+  // step off in rotation alone is the camera turning harder than constant velocity expects (a corner).
+  const bool strongest =
+      !plausible_alternative || (step.translation_plausible && h.inliers > from_prediction.inliers);
   if (strongest && h.inliers >= options_.min_jump_inliers && !h.weak) {
     h.jump = true;
     logger()->warn("frame {}: step {:.2f} m / {:.1f} deg off the constant-velocity prediction (allowed {:.2f} m), "

@@ -230,16 +230,14 @@ TEST_CASE("a corner entered harder than constant velocity expects: the turn is t
   // The simulator's 800-frame double loop enters its first corner at frame 39: the yaw rate jumps to
   // 3.8 deg per frame, 3.2 deg off the prediction (tolerance 3) with the centre within reach. The
   // true pose holds 451 inliers; searched from the prediction, the local map finds 30 wrong matches,
-  // an ok frame's support. Only the first 45 frames are rendered.
-  // When any plausible alternative won, that one did (2026-11-25 to 27: here the jump came a frame
-  // later, ATE 0.100 m and the last pose 0.17 m off, now 0.059 and 0.12 m; the whole 800-frame
-  // double loop 0.253 -> 0.635 m). A turn cannot be faked by something moving in view, a translation can (the
-  // truck of `traffic` seed 3, tested in tests/cli): here the better supported pose wins.
-  rgbl::DemoOptions demo;
+  // an ok frame's support. Only the first 45 frames are rendered. When any plausible alternative won
+  // (2026-11-25 to 27), here the jump came a frame late: ATE 0.100 m and the last pose 0.17 m off, now
+  // 0.059 and 0.12 m (the whole double loop 0.635 -> 0.253 m). Something moving in view can fake a
+  // translation (the truck of `traffic` seed 3, tests/cli), not a turn: the better supported pose wins.
+  rgbl::DemoOptions demo;  // what `rgbl demo --path loop --frames 800 --laps 2` renders
   demo.path = "loop";
   demo.frames = 800;
   demo.laps = 2;
-  demo.loop_closing = false;
   rgbl::PipelineOptions o;
   o.frames = 45;
   o.loop_closing = false;
