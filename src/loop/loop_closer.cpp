@@ -373,10 +373,12 @@ void LoopCloser::correct(Map& map, const DetectedLoop& loop, LoopCloserStep& ste
   LoopClosure& c = *step.closure;
   c.time_ms = step.time_ms;  // detection and correction
   logger()->info("{}: frame {} with frame {} ({} {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
-                 "loop error {:.2f} -> {:.3f} m, {} landmarks fused, global BA {} keyframes {:.0f} ms, {:.0f} ms",
+                 "loop error {:.2f} -> {:.3f} m, keyframes moved up to {:.2f} m, {} landmarks fused, global BA {} "
+                 "keyframes {:.0f} ms, {:.0f} ms",
                  c.merged ? "maps merged" : "loop closed", c.frame_index, c.matched_frame_index, c.place_source,
                  c.place_similarity, c.inliers, c.correction_m, c.correction_deg, c.correction.loop_error_before_m,
-                 c.correction.loop_error_after_m, c.fused_landmarks, c.global_ba_keyframes, c.global_ba_ms, c.time_ms);
+                 c.correction.loop_error_after_m, c.correction.max_keyframe_shift_m, c.fused_landmarks,
+                 c.global_ba_keyframes, c.global_ba_ms, c.time_ms);
 }
 
 void LoopCloser::apply(Map& map, const DetectedLoop& loop, LoopCloserStep& step) {
