@@ -349,7 +349,19 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   // step off in rotation alone is the camera turning harder than constant velocity expects (a corner).
   const bool strongest =
       !plausible_alternative || (step.translation_plausible && h.inliers > from_prediction.inliers);
-  if (strongest && h.inliers >= options_.min_jump_inliers && !h.weak) {
+  // A step the local map does not lead to from the prediction either, a translation beyond a vehicle's
+  // reach from where that search ends, which the LiDAR refuses too, is an image alias: a facade's
+  // windows repeat every bay along the street, depth included, and a pose one bay off agrees with all
+  // of them, but the poles, trees and kerbs the scan sees then land off the last scan. (A step the
+  // search from the prediction also reaches corrects the last frames' error, which the LiDAR, judging
+  // the motion from the last frame, cannot tell from a wrong step: lead-vehicle seed 3, frames 47-50.)
+  const double apart =
+      (h.frame.T_cam_world.inverse().translation() - candidate.T_cam_world.inverse().translation()).norm();
+  std::optional<LidarView> lidar;
+  const bool lidar_refuses =
+      strongest && !step.translation_plausible && apart > step.allowed_translation_m &&
+      lidar_preference(lidar, h.frame, h.frame.T_cam_world, prediction.T_cam_world, "the step", "the prediction") > 0;
+  if (strongest && h.inliers >= options_.min_jump_inliers && !h.weak && !lidar_refuses) {
     h.jump = true;
     logger()->warn("frame {}: step {:.2f} m / {:.1f} deg off the constant-velocity prediction (allowed {:.2f} m), "
                    "taken on {} inliers", h.frame.index, step.translation_m, step.rotation_deg,

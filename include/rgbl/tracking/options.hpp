@@ -113,8 +113,10 @@ struct TrackerOptions {
   // speed within a car's reach) and step_tolerance_rotation_deg. For a larger step the local map is
   // searched from the prediction: a plausible pose found there with an ok frame's support wins (over
   // a step off in rotation alone, with the centre within reach, only when better supported). Else
-  // the step is taken with min_jump_inliers (what a relocalisation needs) and reported as a jump;
-  // otherwise the frame is weak and placed at the prediction.
+  // the step is taken with min_jump_inliers (what a relocalisation needs) and reported as a jump,
+  // unless the search from the prediction ended beyond a step's reach from it and the LiDAR prefers
+  // the prediction (scan_arbitration: a facade's windows one bay along); otherwise the frame is weak
+  // and placed at the prediction.
   bool check_steps = true;
   double step_tolerance = 0.25;            // m
   double step_tolerance_relative = 0.1;
