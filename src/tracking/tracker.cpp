@@ -341,27 +341,28 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
                   "from the prediction the local map finds {} ({:.2f} m off)", h.frame.index, step.translation_m,
                   step.rotation_deg, step.allowed_translation_m, h.inliers, from_prediction.inliers,
                   candidate_step.translation_m);
-  // No LiDAR say here: its vote judges the motion from the last frame, and a step off the prediction
-  // is often the local map correcting the last frames' error (lead-vehicle seed 3, frame 47: the step
-  // undid frame 46's 0.9 deg and 0.3 m, and the LiDAR voted 1421 to 25 for keeping them).
   // A turn is judged on support: something moving in view shifts a pose locked on it by its own
   // displacement (metres at traffic speed) but cannot turn the whole scene, far points included; a
   // step off in rotation alone is the camera turning harder than constant velocity expects (a corner).
   const bool strongest =
       !plausible_alternative || (step.translation_plausible && h.inliers > from_prediction.inliers);
-  // A step the local map does not lead to from the prediction either, a translation beyond a vehicle's
-  // reach from where that search ends, which the LiDAR refuses too, is an image alias: a facade's
-  // windows repeat every bay along the street, depth included, and a pose one bay off agrees with all
-  // of them, but the poles, trees and kerbs the scan sees then land off the last scan. (A step the
-  // search from the prediction also reaches corrects the last frames' error, which the LiDAR, judging
-  // the motion from the last frame, cannot tell from a wrong step: lead-vehicle seed 3, frames 47-50.)
-  const double apart =
-      (h.frame.T_cam_world.inverse().translation() - candidate.T_cam_world.inverse().translation()).norm();
-  std::optional<LidarView> lidar;
-  const bool lidar_refuses =
-      strongest && !step.translation_plausible && apart > step.allowed_translation_m &&
-      lidar_preference(lidar, h.frame, h.frame.T_cam_world, prediction.T_cam_world, "the step", "the prediction") > 0;
-  if (strongest && h.inliers >= options_.min_jump_inliers && !h.weak && !lidar_refuses) {
+  // The LiDAR judges the motion from the last frame, and a step off the prediction is often the local
+  // map correcting the last frames' error (lead-vehicle seed 3, frame 47: the step undid frame 46's
+  // 0.9 deg and 0.3 m, and the LiDAR voted 1421 to 25 for keeping them); there the search from the
+  // prediction ends at the step too. So it has a say only over a step beyond a vehicle's reach from
+  // where that search ended as well: an image alias, e.g. a facade's windows, which repeat every bay
+  // along the street, depth included, while the poles, trees and kerbs the scan sees do not. Asked
+  // only for a step that would otherwise be taken: the vote reads the whole scan sample.
+  const auto lidar_refuses = [&] {
+    if (step.translation_plausible ||
+        check_step(h.frame.T_cam_world, candidate.T_cam_world, predicted_step, dt, options_).translation_plausible) {
+      return false;
+    }
+    std::optional<LidarView> lidar;
+    return lidar_preference(lidar, h.frame, h.frame.T_cam_world, prediction.T_cam_world, "the step",
+                            "the prediction") > 0;
+  };
+  if (strongest && h.inliers >= options_.min_jump_inliers && !h.weak && !lidar_refuses()) {
     h.jump = true;
     logger()->warn("frame {}: step {:.2f} m / {:.1f} deg off the constant-velocity prediction (allowed {:.2f} m), "
                    "taken on {} inliers", h.frame.index, step.translation_m, step.rotation_deg,
