@@ -11,6 +11,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <ranges>
 #include <vector>
 
 namespace rgbl {
@@ -37,31 +38,47 @@ struct Search {
   std::vector<LandmarkId> landmarks;  // region_landmarks of `matched`
 };
 
+// How close (m) a point at `depth` must come to agree in 3-D.
+double tolerance(double depth, const LoopVerificationOptions& o) {
+  return std::max(o.min_tolerance, o.relative_tolerance * depth);
+}
+
+// Ratio test against the nearest landmark *elsewhere*: the second best is the closest descriptor among
+// landmarks beyond the 3-D agreement tolerance of the best one. Keyframes whose landmarks were never
+// fused leave one point in the region twice, centimetres apart with nearly equal descriptors; those
+// copies are no ambiguity (either fixes the same pose), while the copies of a repeated facade, metres
+// apart, still are.
 std::vector<PointMatch> match_descriptors(const Search& s) {
   const Keyframe& current = s.current;
+  std::vector<const Landmark*> landmarks;
+  landmarks.reserve(s.landmarks.size());
+  for (const LandmarkId id : s.landmarks) landmarks.push_back(s.map.landmark(id));
+  std::vector<int> distance(landmarks.size());
   // landmark -> (keypoint, distance): each landmark keeps its best keypoint
   std::map<int, std::pair<int, int>> best_of_landmark;
   for (std::size_t i = 0; i < current.keypoints.size(); ++i) {
     if (current.depth[i] <= 0.0F) continue;
-    int best = 256, second = 256;
-    LandmarkId best_id;
-    for (const LandmarkId id : s.landmarks) {
-      const int d = hamming_distance(current.descriptors[i], s.map.landmark(id)->descriptor);
-      if (d < best) {
-        second = best;
-        best = d;
-        best_id = id;
-      } else if (d < second) {
-        second = d;
+    int best = 256;
+    std::size_t best_j = landmarks.size();
+    for (std::size_t j = 0; j < landmarks.size(); ++j) {
+      distance[j] = hamming_distance(current.descriptors[i], landmarks[j]->descriptor);
+      if (distance[j] < best) {
+        best = distance[j];
+        best_j = j;
       }
     }
-    if (!best_id.valid() || best > s.options.max_hamming ||
-        static_cast<float>(best) >= s.options.ratio * static_cast<float>(second)) {
-      continue;
-    }
-    const auto it = best_of_landmark.find(best_id.value);
+    if (best_j == landmarks.size() || best > s.options.max_hamming) continue;
+    const double elsewhere = tolerance(current.depth[i], s.options);
+    const Eigen::Vector3d& at = landmarks[best_j]->position;
+    const bool ambiguous = std::ranges::any_of(std::views::iota(std::size_t{0}, landmarks.size()), [&](std::size_t j) {
+      return j != best_j && static_cast<float>(best) >= s.options.ratio * static_cast<float>(distance[j]) &&
+             (landmarks[j]->position - at).norm() > elsewhere;
+    });
+    if (ambiguous) continue;
+    const int best_id = s.landmarks[best_j].value;
+    const auto it = best_of_landmark.find(best_id);
     if (it == best_of_landmark.end() || best < it->second.second) {
-      best_of_landmark[best_id.value] = {static_cast<int>(i), best};
+      best_of_landmark[best_id] = {static_cast<int>(i), best};
     }
   }
   std::vector<PointMatch> matches;
@@ -77,9 +94,7 @@ std::vector<PointMatch> match_descriptors(const Search& s) {
   return matches;
 }
 
-double tolerance(const PointMatch& m, const LoopVerificationOptions& o) {
-  return std::max(o.min_tolerance, o.relative_tolerance * m.p_cam.z());
-}
+double tolerance(const PointMatch& m, const LoopVerificationOptions& o) { return tolerance(m.p_cam.z(), o); }
 
 bool agrees(const PointMatch& m, const Eigen::Isometry3d& T_cam_world, const LoopVerificationOptions& options) {
   return (T_cam_world * m.p_world - m.p_cam).norm() < tolerance(m, options);

@@ -20,7 +20,9 @@ namespace rgbl {
 struct LoopVerificationOptions {
   std::size_t neighbours = 5;   // best covisible keyframes of the candidate whose landmarks join
   int max_hamming = 50;         // descriptor distance of a match
-  float ratio = 0.75F;          // best < ratio * second best (a loop is matched without a pose prior)
+  // best < ratio * the best among landmarks farther than the agreement tolerance from the best one (a
+  // loop is matched without a pose prior; two copies of one point are not an ambiguity)
+  float ratio = 0.75F;
   int ransac_iterations = 300;
   std::uint32_t seed = 1;       // fixed: the same map gives the same answer
   // A match agrees with a motion within max(min_tolerance, relative_tolerance * z) m in 3-D.
