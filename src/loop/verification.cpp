@@ -11,7 +11,6 @@
 #include <cmath>
 #include <map>
 #include <random>
-#include <ranges>
 #include <vector>
 
 namespace rgbl {
@@ -70,10 +69,11 @@ std::vector<PointMatch> match_descriptors(const Search& s) {
     if (best_j == landmarks.size() || best > s.options.max_hamming) continue;
     const double elsewhere = tolerance(current.depth[i], s.options);
     const Eigen::Vector3d& at = landmarks[best_j]->position;
-    const bool ambiguous = std::ranges::any_of(std::views::iota(std::size_t{0}, landmarks.size()), [&](std::size_t j) {
-      return j != best_j && static_cast<float>(best) >= s.options.ratio * static_cast<float>(distance[j]) &&
-             (landmarks[j]->position - at).norm() > elsewhere;
-    });
+    bool ambiguous = false;
+    for (std::size_t j = 0; j < landmarks.size() && !ambiguous; ++j) {
+      ambiguous = j != best_j && static_cast<float>(best) >= s.options.ratio * static_cast<float>(distance[j]) &&
+                  (landmarks[j]->position - at).norm() > elsewhere;
+    }
     if (ambiguous) continue;
     const int best_id = s.landmarks[best_j].value;
     const auto it = best_of_landmark.find(best_id);
