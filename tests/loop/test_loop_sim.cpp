@@ -126,7 +126,7 @@ TEST_CASE("loop closer: two laps of the simulator's loop are closed where the pl
   fmt::print("two laps of a 100 m loop: {} closures, ATE {:.3f} m (without loop closing {:.3f} m)\n", closures, with.ate,
              without.ate);
   // measured: 1 closure (frame 91 with frame 0; the map agrees with the loop afterwards), ATE 0.054 m
-  // against 1.438 m (with the global bundle adjustment, off by default: docs/loop-closing.md)
+  // against 1.438 m (0.063 m with the global bundle adjustment, off by default: docs/loop-closing.md)
   CHECK(closures >= 1);
   CHECK(with.loops.closures == closures);
   CHECK(with.loops.implausible == 0);  // a true loop asks for no more than odometry drifts

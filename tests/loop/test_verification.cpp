@@ -52,26 +52,25 @@ void build(CopiedMap& m, const Eigen::Vector3d& offset) {
     for (auto& byte : d) byte = static_cast<std::uint8_t>(rng());
     points.push_back({p, d});
   }
-  rgbl::Keyframe matched;
+  // each point and its copy, in the order of the matched keyframe's keypoints
+  std::vector<Point> mapped;
   for (const Point& point : points) {
-    for (const auto& [p, d] : {std::pair{point.p, point.d}, std::pair{Eigen::Vector3d(point.p + offset), flip(point.d, 4)}}) {
-      const auto px = m.camera.project(p);
-      rgbl::Keypoint k;
-      k.x = static_cast<float>(px ? px->x() : 0.0);
-      k.y = static_cast<float>(px ? px->y() : 0.0);
-      matched.keypoints.push_back(k);
-      matched.descriptors.push_back(d);
-      matched.depth.push_back(static_cast<float>(p.z()));
-    }
+    mapped.push_back(point);
+    mapped.push_back({point.p + offset, flip(point.d, 4)});
+  }
+  rgbl::Keyframe matched;
+  for (const Point& point : mapped) {
+    const auto px = m.camera.project(point.p);  // a copy may fall outside: its keypoint is never searched
+    matched.keypoints.push_back({.x = static_cast<float>(px ? px->x() : 0.0), .y = static_cast<float>(px ? px->y() : 0.0)});
+    matched.descriptors.push_back(point.d);
+    matched.depth.push_back(static_cast<float>(point.p.z()));
   }
   matched.landmarks.resize(matched.keypoints.size());
   m.matched = m.map.add_keyframe(std::move(matched));
-  for (std::size_t i = 0; i < 2 * points.size(); ++i) {
-    const Eigen::Vector3d p = points[i / 2].p + (i % 2 == 0 ? Eigen::Vector3d::Zero() : offset);
-    const rgbl::LandmarkId id = m.map.add_landmark(p, m.matched);
-    m.map.landmark(id)->descriptor = m.map.keyframe(m.matched)->descriptors[i];
+  for (std::size_t i = 0; i < mapped.size(); ++i) {
+    const rgbl::LandmarkId id = m.map.add_landmark(mapped[i].p, m.matched);
     m.map.add_observation(id, m.matched, static_cast<int>(i));
-    m.map.update_landmark(id);
+    m.map.update_landmark(id);  // its descriptor: the one observation's
   }
   for (const Point& point : points) {
     const Eigen::Vector3d p_cam = m.T_cam_world * point.p;
@@ -107,6 +106,7 @@ TEST_CASE("loop verification: two copies of a point are one match, copies metres
     CHECK(counts.matches < rgbl::LoopVerificationOptions{}.min_ransac_inliers);
   }
 }
+
 TEST_CASE("loop verification measures the relative pose of two keyframes of one real drive") {
   const auto dir = rgbl::test::kitti_seq04();
   if (!dir) return;
