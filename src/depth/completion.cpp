@@ -346,13 +346,13 @@ template <class S>
 
 RGBL_CLONES_AVX2 void diamond5_avx2(const DiamondBlock& b) { diamond5_block<Keys>(b); }
 
-#if defined(RGBL_X86_DISPATCH)
+#if defined(RGBL_X86_DISPATCH) && !defined(RGBL_NO_AVX512)
 __attribute__((target("arch=x86-64-v4"))) void diamond5_avx512(const DiamondBlock& b) { diamond5_block<Keys16>(b); }
 #endif
 
 // The widest build the CPU runs (a cached CPUID bit, nothing next to a block).
 void diamond5(const DiamondBlock& b) {
-#if defined(RGBL_X86_DISPATCH)
+#if defined(RGBL_X86_DISPATCH) && !defined(RGBL_NO_AVX512)
   if (__builtin_cpu_supports("x86-64-v4")) return diamond5_avx512(b);
 #endif
   diamond5_avx2(b);

@@ -231,7 +231,7 @@ bool cpu_has_avx2() {
 }
 
 bool cpu_has_avx512bw() {
-#if defined(RGBL_HAVE_AVX2_PATH)
+#if defined(RGBL_HAVE_AVX2_PATH) && !defined(RGBL_NO_AVX512)
   static const bool has = __builtin_cpu_supports("avx512bw") != 0;
   return has;
 #else
