@@ -246,15 +246,15 @@ void OrbExtractor::detect_level(int level) {
   };
   cell_strong.assign(static_cast<std::size_t>(cols * rows), 0);
   const int strong = options_.fast_threshold;
+  // Both loops branch-free: whether a corner is strong is a coin flip to a branch predictor.
+  for (const auto& k : fast) cell_strong[cell_of(k)] |= static_cast<unsigned char>(k.score >= strong);
+  candidates.resize(fast.size());
+  std::size_t kept = 0;
   for (const auto& k : fast) {
-    if (k.score >= strong) cell_strong[cell_of(k)] = 1;
+    candidates[kept] = {static_cast<float>(k.x), static_cast<float>(k.y), static_cast<float>(k.score)};
+    kept += static_cast<std::size_t>(k.score >= strong) | static_cast<std::size_t>(cell_strong[cell_of(k)] == 0);
   }
-  candidates.reserve(fast.size());
-  for (const auto& k : fast) {
-    if (k.score >= strong || cell_strong[cell_of(k)] == 0) {
-      candidates.push_back({static_cast<float>(k.x), static_cast<float>(k.y), static_cast<float>(k.score)});
-    }
-  }
+  candidates.resize(kept);
 }
 
 // Quadtree over the candidates: split nodes (breadth first) until there are target / per_node nodes or
@@ -282,11 +282,11 @@ void OrbExtractor::distribute(int target, Level& level) {
   const int per_node = options_.features_per_node;
   const int target_nodes = (spread_target + per_node - 1) / per_node;
   float min_x = candidates[0].x, max_x = min_x, min_y = candidates[0].y, max_y = min_y;
-  for (const auto& c : candidates) {
-    min_x = std::min(min_x, c.x);
-    max_x = std::max(max_x, c.x);
-    min_y = std::min(min_y, c.y);
-    max_y = std::max(max_y, c.y);
+  for (const auto& c : candidates) {  // (as std::min and std::max, written so they stay in registers)
+    min_x = c.x < min_x ? c.x : min_x;
+    max_x = max_x < c.x ? c.x : max_x;
+    min_y = c.y < min_y ? c.y : min_y;
+    max_y = max_y < c.y ? c.y : max_y;
   }
   max_x += 1.0F;  // half-open boxes
   max_y += 1.0F;
