@@ -282,11 +282,11 @@ void OrbExtractor::distribute(int target, Level& level) {
   const int per_node = options_.features_per_node;
   const int target_nodes = (spread_target + per_node - 1) / per_node;
   float min_x = candidates[0].x, max_x = min_x, min_y = candidates[0].y, max_y = min_y;
-  for (const auto& c : candidates) {  // (as std::min and std::max, written so they stay in registers)
-    min_x = c.x < min_x ? c.x : min_x;
-    max_x = max_x < c.x ? c.x : max_x;
-    min_y = c.y < min_y ? c.y : min_y;
-    max_y = max_y < c.y ? c.y : max_y;
+  for (const auto& c : candidates) {
+    min_x = std::min(min_x, c.x);
+    max_x = std::max(max_x, c.x);
+    min_y = std::min(min_y, c.y);
+    max_y = std::max(max_y, c.y);
   }
   max_x += 1.0F;  // half-open boxes
   max_y += 1.0F;
