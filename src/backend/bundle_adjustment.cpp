@@ -3,7 +3,6 @@
 #include "rgbl/core/error.hpp"
 
 #include <ceres/ceres.h>
-#include <ceres/rotation.h>
 
 #include <cmath>
 #include <memory>
@@ -11,38 +10,72 @@
 namespace rgbl {
 namespace {
 
-// Pose block: [angle-axis of R_cam_world (3), t_cam_world (3)]; point block: world position.
-template <int kDim>
-struct ReprojectionDepthCost {
-  PinholeCamera camera;
-  double u, v, inv_sigma_px;
-  double z, inv_sigma_z;
+// Parameter blocks: rotation of R_cam_world as angle-axis (3), t_cam_world (3), the point's world
+// position (3). Every residual has three rows, the third zero without depth: with all row and
+// parameter blocks of size 3 Ceres runs its fixed-size Schur eliminator (SchurEliminator<3, 3, 3>)
+// instead of the dynamic one, and the zero row adds exact zeros to the normal equations.
+// Analytic Jacobians: automatic differentiation of the angle-axis rotation was as costly as the
+// linear algebra of a local BA.
+class ReprojectionDepthCost final : public ceres::SizedCostFunction<3, 3, 3, 3> {
+ public:
+  ReprojectionDepthCost(const PinholeCamera& camera, const BundleObservation& o)
+      : camera_(camera), pixel_(o.pixel), inv_sigma_px_(1.0 / o.sigma_px),
+        depth_(o.depth), inv_sigma_z_(o.depth > 0.0 && o.depth_sigma > 0.0 ? 1.0 / o.depth_sigma : 0.0) {}
 
-  template <typename T>
-  bool operator()(const T* pose, const T* point, T* residual) const {
-    T p[3];
-    ceres::AngleAxisRotatePoint(pose, point, p);
-    p[0] += pose[3];
-    p[1] += pose[4];
-    p[2] += pose[5];
-    const Eigen::Matrix<T, 2, 1> px = project_point(camera, p[0], p[1], p[2]);
-    residual[0] = (px.x() - u) * inv_sigma_px;
-    residual[1] = (px.y() - v) * inv_sigma_px;
-    if constexpr (kDim == 3) residual[2] = (p[2] - T(z)) * T(inv_sigma_z);
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const Eigen::Map<const Eigen::Vector3d> w(parameters[0]), t(parameters[1]), x(parameters[2]);
+    const double theta2 = w.squaredNorm();
+    const Eigen::Matrix3d R = so3_exp(w);
+    const Eigen::Vector3d Rx = R * x;
+    const Eigen::Vector3d p = Rx + t;
+    const double inv_z = 1.0 / p.z();
+    Eigen::Vector2d xn(p.x() * inv_z, p.y() * inv_z);
+    const Eigen::Vector2d xu = xn;
+    if (!camera_.distortion.is_zero()) camera_.distortion.apply(xn.x(), xn.y());
+    residuals[0] = (camera_.fx * xn.x() + camera_.cx - pixel_.x()) * inv_sigma_px_;
+    residuals[1] = (camera_.fy * xn.y() + camera_.cy - pixel_.y()) * inv_sigma_px_;
+    residuals[2] = inv_sigma_z_ > 0.0 ? (p.z() - depth_) * inv_sigma_z_ : 0.0;
+    if (jacobians == nullptr) return true;
+
+    // d(residual) / d(p): the whitened projection, then the depth row.
+    Eigen::Matrix<double, 2, 3> dxn_dp;
+    dxn_dp << inv_z, 0.0, -xu.x() * inv_z, 0.0, inv_z, -xu.y() * inv_z;
+    Eigen::Matrix2d K;
+    K << camera_.fx, 0.0, 0.0, camera_.fy;
+    if (!camera_.distortion.is_zero()) K = K * camera_.distortion.jacobian(xu.x(), xu.y());
+    Eigen::Matrix3d dr_dp;
+    dr_dp.topRows<2>() = inv_sigma_px_ * K * dxn_dp;
+    dr_dp.row(2) << 0.0, 0.0, inv_sigma_z_;
+
+    using RowMajor3d = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+    if (jacobians[0] != nullptr) {
+      // R(w + dw) x = R x - hat(R x) J_l(w) dw, with J_l the left Jacobian of SO(3).
+      const Eigen::Matrix3d W = hat(w);
+      Eigen::Matrix3d J_l = Eigen::Matrix3d::Identity();
+      if (theta2 < 1e-10) {
+        J_l += 0.5 * W + (1.0 / 6.0) * W * W;
+      } else {
+        const double theta = std::sqrt(theta2);
+        J_l += ((1.0 - std::cos(theta)) / theta2) * W + ((theta - std::sin(theta)) / (theta2 * theta)) * W * W;
+      }
+      Eigen::Map<RowMajor3d> d_rotation(jacobians[0]);
+      d_rotation = -dr_dp * hat(Rx) * J_l;
+    }
+    if (jacobians[1] != nullptr) Eigen::Map<RowMajor3d>{jacobians[1]} = dr_dp;
+    if (jacobians[2] != nullptr) Eigen::Map<RowMajor3d>{jacobians[2]} = dr_dp * R;
     return true;
   }
+
+ private:
+  PinholeCamera camera_;
+  Eigen::Vector2d pixel_;
+  double inv_sigma_px_, depth_, inv_sigma_z_;
 };
 
 bool has_depth(const BundleObservation& o) { return o.depth > 0.0 && o.depth_sigma > 0.0; }
 
 ceres::CostFunction* make_cost(const PinholeCamera& camera, const BundleObservation& o) {
-  if (has_depth(o)) {
-    return new ceres::AutoDiffCostFunction<ReprojectionDepthCost<3>, 3, 6, 3>(new ReprojectionDepthCost<3>{
-        camera, o.pixel.x(), o.pixel.y(), 1.0 / o.sigma_px, o.depth,
-        1.0 / o.depth_sigma});
-  }
-  return new ceres::AutoDiffCostFunction<ReprojectionDepthCost<2>, 2, 6, 3>(new ReprojectionDepthCost<2>{
-      camera, o.pixel.x(), o.pixel.y(), 1.0 / o.sigma_px, 0.0, 0.0});
+  return new ReprojectionDepthCost(camera, o);
 }
 
 class AbortCallback : public ceres::IterationCallback {
@@ -85,18 +118,16 @@ int bundle_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_
                     const BundleObservation& observation, Eigen::Vector3d& residual,
                     Eigen::Matrix<double, 3, 6>& d_pose, Eigen::Matrix3d& d_point) {
   const std::unique_ptr<ceres::CostFunction> cost(make_cost(camera, observation));
-  const int dim = cost->num_residuals();
   Vector6d pose = pose_to_parameters(T_cam_world);
   Eigen::Vector3d p = point;
-  const double* parameters[2] = {pose.data(), p.data()};
-  Eigen::Matrix<double, 3, 6, Eigen::RowMajor> jp = Eigen::Matrix<double, 3, 6, Eigen::RowMajor>::Zero();
-  Eigen::Matrix<double, 3, 3, Eigen::RowMajor> jx = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>::Zero();
-  double* jacobians[2] = {jp.data(), jx.data()};
+  const double* parameters[3] = {pose.data(), pose.data() + 3, p.data()};
+  Eigen::Matrix<double, 3, 3, Eigen::RowMajor> jr, jt, jx;
+  double* jacobians[3] = {jr.data(), jt.data(), jx.data()};
   residual.setZero();
   cost->Evaluate(parameters, residual.data(), jacobians);
-  d_pose = jp;
+  d_pose << jr, jt;
   d_point = jx;
-  return dim;
+  return has_depth(observation) ? 3 : 2;
 }
 
 BundleAdjustmentResult bundle_adjust(const PinholeCamera& camera, BundleProblem& problem,
@@ -115,18 +146,23 @@ BundleAdjustmentResult bundle_adjust(const PinholeCamera& camera, BundleProblem&
   const double delta2 = std::sqrt(options.chi2_2d), delta3 = std::sqrt(options.chi2_3d);
   std::vector<bool> pose_used(poses.size(), false), point_used(problem.points.size(), false);
   for (const BundleObservation& o : problem.observations) {
-    double* pose = poses[static_cast<std::size_t>(o.pose)].data();
+    double* rotation = poses[static_cast<std::size_t>(o.pose)].data();
+    double* translation = rotation + 3;
     double* point = problem.points[static_cast<std::size_t>(o.point)].data();
-    ceres_problem.AddResidualBlock(make_cost(camera, o), new ceres::HuberLoss(has_depth(o) ? delta3 : delta2), pose,
-                                   point);
+    ceres_problem.AddResidualBlock(make_cost(camera, o), new ceres::HuberLoss(has_depth(o) ? delta3 : delta2),
+                                   rotation, translation, point);
     if (!point_used[static_cast<std::size_t>(o.point)]) {
       point_used[static_cast<std::size_t>(o.point)] = true;
       ordering->AddElementToGroup(point, 0);
     }
     if (!pose_used[static_cast<std::size_t>(o.pose)]) {
       pose_used[static_cast<std::size_t>(o.pose)] = true;
-      ordering->AddElementToGroup(pose, 1);
-      if (problem.poses[static_cast<std::size_t>(o.pose)].fixed) ceres_problem.SetParameterBlockConstant(pose);
+      ordering->AddElementToGroup(rotation, 1);
+      ordering->AddElementToGroup(translation, 1);
+      if (problem.poses[static_cast<std::size_t>(o.pose)].fixed) {
+        ceres_problem.SetParameterBlockConstant(rotation);
+        ceres_problem.SetParameterBlockConstant(translation);
+      }
     }
   }
 
