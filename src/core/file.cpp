@@ -261,8 +261,7 @@ void require_image_file(const std::filesystem::path& file, std::string_view what
   const auto read = static_cast<std::size_t>(in.gcount());
   const bool png = read >= kSignature.size() && std::equal(kSignature.begin(), kSignature.end(), header.begin());
   const bool jpeg = read >= 3 && header[0] == 0xFF && header[1] == 0xD8 && header[2] == 0xFF;
-  // Only PNG and JPEG reach the decoder: cv::imread picks a decoder by the content, and some of
-  // OpenCV's (GDCM for DICOM) abort the process on malformed input instead of failing.
+  // Only PNG and JPEG reach a decoder (rgbl/io/image.hpp): anything else gets this clear message.
   if (!png && !jpeg) {
     throw ParseError(file, 0, fmt::format("not a PNG or JPEG file (by its first bytes; expected {})", what));
   }

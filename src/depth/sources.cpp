@@ -7,7 +7,6 @@
 
 #include <fmt/format.h>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -57,8 +56,8 @@ void RgbdSourceOptions::validate() const {
 
 cv::Mat_<float> read_depth_png(const std::filesystem::path& file) {
   require_image_file(file, "a depth PNG (uint16, depth x 256)");
-  const cv::Mat raw = cv::imread(file.string(), cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
-  if (raw.empty() || raw.type() != CV_16UC1) throw ParseError(file, 0, "a single-channel uint16 PNG (depth x 256)");
+  const cv::Mat raw = read_image_file(file, ImageMode::grey_any_depth);
+  if (raw.type() != CV_16UC1) throw ParseError(file, 0, "a single-channel uint16 PNG (depth x 256)");
   cv::Mat_<float> depth;
   raw.convertTo(depth, CV_32F, 1.0 / 256.0);
   return depth;

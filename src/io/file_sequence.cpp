@@ -7,7 +7,6 @@
 #include "text.hpp"
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
@@ -73,7 +72,7 @@ class FileSequence final : public Sequence {
   }
 
   cv::Mat_<float> read_depth(const std::filesystem::path& file) const {
-    const cv::Mat raw = read_image_file(file, cv::IMREAD_ANYDEPTH);
+    const cv::Mat raw = read_image_file(file, ImageMode::grey_any_depth);
     if (raw.type() != CV_16UC1) throw ParseError(file, 0, "expected a 16-bit single-channel depth PNG");
     const int w = table_.calibration.width[2];
     const int h = table_.calibration.height[2];
@@ -98,7 +97,7 @@ std::unique_ptr<Sequence> make_file_sequence(SequenceTable table, const LoadOpti
 }
 
 cv::Mat read_image(const std::filesystem::path& file, bool grey) {
-  return read_image_file(file, grey ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+  return read_image_file(file, grey ? ImageMode::grey : ImageMode::colour);
 }
 
 void set_image_sizes(SequenceTable& table) {
@@ -147,41 +146,3 @@ void require_frames(const std::filesystem::path& dir, std::size_t count, int dig
 
 }  // namespace rgbl::detail
 
-namespace rgbl {
-
-void write_png_file(const std::filesystem::path& file, const cv::Mat& image) {
-  std::vector<unsigned char> png;
-  if (image.empty() || !cv::imencode(".png", image, png)) {
-    throw Error(fmt::format("{}: cannot encode a PNG of this image ({}x{}, type {})", file.string(), image.cols,
-                            image.rows, image.type()));
-  }
-  write_atomically(file, png);
-}
-
-cv::Mat encode_depth16(const cv::Mat_<float>& depth) {
-  cv::Mat_<std::uint16_t> out(depth.rows, depth.cols);
-  for (int v = 0; v < depth.rows; ++v) {
-    const float* in = depth[v];
-    std::uint16_t* row = out[v];
-    for (int u = 0; u < depth.cols; ++u) {
-      const double scaled = std::round(static_cast<double>(in[u]) * 256.0);
-      row[u] = scaled > 0.0 && scaled <= 65535.0 ? static_cast<std::uint16_t>(scaled) : 0;
-    }
-  }
-  return out;
-}
-
-cv::Mat read_image_file(const std::filesystem::path& file, int flags) {
-  constexpr std::string_view kWhat = "an image file";
-  require_image_file(file, kWhat);
-  cv::Mat image;
-  try {
-    image = cv::imread(file.string(), flags);
-  } catch (const cv::Exception& e) {  // e.g. OpenCV's own size limit
-    throw ParseError(file, 0, fmt::format("cannot read or decode the image (OpenCV: {})", e.err));
-  }
-  if (image.empty()) throw ParseError(file, 0, "cannot read or decode the image (corrupt or truncated PNG?)");
-  return image;
-}
-
-}  // namespace rgbl

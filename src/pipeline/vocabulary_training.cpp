@@ -4,7 +4,6 @@
 #include "rgbl/io/image.hpp"
 #include "rgbl/core/timer.hpp"
 
-#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -51,7 +50,7 @@ VocabularyTraining train_vocabulary(const std::vector<std::filesystem::path>& fo
   std::vector<Keypoint> keypoints;
   VocabularyTraining out;
   for (const auto& image : images) {
-    const cv::Mat gray = read_image_file(image, cv::IMREAD_GRAYSCALE);
+    const cv::Mat gray = read_image_file(image, ImageMode::grey);
     descriptors.emplace_back();
     extractor.extract(gray, keypoints, descriptors.back());
     out.descriptors += descriptors.back().size();

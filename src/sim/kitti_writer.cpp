@@ -5,7 +5,6 @@
 
 #include <fmt/format.h>
 #include <fmt/os.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
 #include <fstream>

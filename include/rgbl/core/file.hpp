@@ -77,9 +77,9 @@ std::ifstream open_input_file(const std::filesystem::path& file, std::string_vie
 // once decoded, so its header is refused before decoding.
 inline constexpr std::uint64_t kMaxImagePixels = 50'000'000;
 
-// require_input_file, a PNG or JPEG by its first bytes (ParseError otherwise: OpenCV would pick other
-// decoders by content, some of which abort on malformed input), and for a PNG (the datasets' format)
-// a header of at most kMaxImagePixels pixels.
+// require_input_file, a PNG or JPEG by its first bytes (ParseError otherwise: the only formats
+// rgbl/io/image.hpp decodes), and for a PNG (the datasets' format) a header of at most
+// kMaxImagePixels pixels.
 void require_image_file(const std::filesystem::path& file, std::string_view what);
 
 }  // namespace rgbl

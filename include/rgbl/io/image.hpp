@@ -4,14 +4,24 @@
 #include <opencv2/core/mat.hpp>
 
 #include <filesystem>
+#include <vector>
 
 namespace rgbl {
 
-// Decodes `file` with cv::imread's `flags` (cv::IMREAD_GRAYSCALE, IMREAD_COLOR, IMREAD_ANYDEPTH). The
-// file must be a readable regular file and, for a PNG, at most kMaxImagePixels large (checked on its
-// header before decoding; see rgbl/core/file.hpp). Throws ParseError naming the file otherwise or when
-// it cannot be decoded; never returns an empty image.
-cv::Mat read_image_file(const std::filesystem::path& file, int flags);
+// What read_image_file returns, as cv::imread's flags would: 8-bit grey (IMREAD_GRAYSCALE), 8-bit BGR
+// (IMREAD_COLOR), or grey at the file's own depth, 16 bits for a 16-bit file (IMREAD_ANYDEPTH).
+enum class ImageMode { grey, colour, grey_any_depth };
+
+// Decodes a PNG or JPEG `file` to the pixels cv::imread gives for the same mode (libpng and libjpeg
+// set up as OpenCV 4.6 does), without OpenCV's imgcodecs. The file must be a readable regular file
+// and at most kMaxImagePixels large (checked on its header before decoding; see rgbl/core/file.hpp).
+// Throws ParseError naming the file otherwise or when it cannot be decoded; never returns an empty
+// image.
+cv::Mat read_image_file(const std::filesystem::path& file, ImageMode mode);
+
+// `image` (8- or 16-bit; 1, 3 (BGR) or 4 (BGRA) channels) as the bytes of a PNG file. Throws Error
+// for other images.
+std::vector<unsigned char> encode_png(const cv::Mat& image);
 
 // Encodes `image` as PNG and writes it through write_atomically (rgbl/core/file.hpp): a reader never
 // sees half a file, an interrupted writer leaves none. Throws Error naming the file.
