@@ -3,11 +3,11 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/io/image.hpp"
 #include "rgbl/depth/sources.hpp"
 #include "rgbl/geometry/calibration.hpp"
 #include "support/data.hpp"
@@ -195,8 +195,8 @@ TEST_CASE("stereo_sparse on real KITTI frames: exact on a shifted real image, cl
   auto lidar = registry.create("lidar", s);
   const auto scan = rgbl::read_kitti_scan(*seq / "velodyne/000000.bin");
   rgbl::SensorFrame frame;
-  frame.image = cv::imread((*seq / "image_0/000000.png").string(), cv::IMREAD_GRAYSCALE);
-  frame.image_right = cv::imread((*seq / "image_1/000000.png").string(), cv::IMREAD_GRAYSCALE);
+  frame.image = rgbl::read_image_file(*seq / "image_0/000000.png", rgbl::ImageMode::grey);
+  frame.image_right = rgbl::read_image_file(*seq / "image_1/000000.png", rgbl::ImageMode::grey);
   frame.scan = scan;
   REQUIRE(!frame.image.empty());
   REQUIRE(!frame.image_right.empty());

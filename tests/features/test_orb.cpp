@@ -1,4 +1,5 @@
 #include "rgbl/core/error.hpp"
+#include "rgbl/io/image.hpp"
 #include "rgbl/features/matcher.hpp"
 #include "rgbl/core/task_pool.hpp"
 #include "rgbl/features/orb.hpp"
@@ -9,7 +10,6 @@
 
 #include <catch2/catch.hpp>
 #include <opencv2/features2d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -44,7 +44,7 @@ std::optional<cv::Mat> kitti_frame(int frame = 0) {
   if (!seq) return std::nullopt;
   char name[32];
   std::snprintf(name, sizeof(name), "image_0/%06d.png", frame);
-  cv::Mat img = cv::imread((*seq / name).string(), cv::IMREAD_GRAYSCALE);
+  cv::Mat img = rgbl::read_image_file(*seq / name, rgbl::ImageMode::grey);
   REQUIRE(!img.empty());
   return img;
 }

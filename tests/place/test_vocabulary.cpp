@@ -1,4 +1,5 @@
 #include "rgbl/place/place_recognition.hpp"
+#include "rgbl/io/image.hpp"
 #include "rgbl/place/vocabulary.hpp"
 
 #include "rgbl/core/error.hpp"
@@ -6,7 +7,6 @@
 #include "support/data.hpp"
 
 #include <catch2/catch.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -63,7 +63,7 @@ std::vector<rgbl::Descriptor> describe(const std::filesystem::path& image) {
   rgbl::OrbExtractor extractor;
   std::vector<rgbl::Keypoint> keypoints;
   std::vector<rgbl::Descriptor> descriptors;
-  const cv::Mat gray = cv::imread(image.string(), cv::IMREAD_GRAYSCALE);
+  const cv::Mat gray = rgbl::read_image_file(image, rgbl::ImageMode::grey);
   REQUIRE(!gray.empty());
   extractor.extract(gray, keypoints, descriptors);
   return descriptors;

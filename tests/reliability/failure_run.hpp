@@ -2,6 +2,7 @@
 // Runs the System (LiDAR depth, rgbl's ORB) on frames of the real KITTI excerpt with injected
 // failures: black images, dropped scans, jumps in the frame sequence. Header-only test support.
 #include "rgbl/core/error.hpp"
+#include "rgbl/io/image.hpp"
 #include "rgbl/depth/sources.hpp"
 #include "rgbl/features/orb.hpp"
 #include "rgbl/geometry/calibration.hpp"
@@ -11,7 +12,6 @@
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include <filesystem>
 #include <memory>
@@ -36,7 +36,7 @@ struct Outcome {
 
 inline Outcome run(const std::filesystem::path& sequence, const std::vector<Step>& steps, bool threaded = false) {
   const auto name = [](std::size_t i) { return fmt::format("{:06}", i); };
-  const cv::Mat first = cv::imread((sequence / "image_0" / (name(0) + ".png")).string(), cv::IMREAD_GRAYSCALE);
+  const cv::Mat first = rgbl::read_image_file(sequence / "image_0" / (name(0) + ".png"), rgbl::ImageMode::grey);
   const auto kitti = rgbl::read_kitti_odometry_calibration(sequence / "calib.txt", first.cols, first.rows);
   rgbl::DepthSourceContext depth;
   depth.calibration = kitti.camera(0);
@@ -55,7 +55,7 @@ inline Outcome run(const std::filesystem::path& sequence, const std::vector<Step
     rgbl::SensorFrame frame;
     frame.index = step.index.value_or(step.frame);
     frame.timestamp = 0.1 * static_cast<double>(frame.index);
-    frame.image = cv::imread((sequence / "image_0" / (name(step.frame) + ".png")).string(), cv::IMREAD_GRAYSCALE);
+    frame.image = rgbl::read_image_file(sequence / "image_0" / (name(step.frame) + ".png"), rgbl::ImageMode::grey);
     REQUIRE(!frame.image.empty());
     if (step.black) frame.image = cv::Mat::zeros(frame.image.size(), CV_8UC1);
     scan.clear();
