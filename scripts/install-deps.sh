@@ -7,6 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev                               # Eigen 3.4
   libopencv-dev                               # OpenCV 4.6
+  libpng-dev libjpeg62-turbo-dev              # image files (src/io/image.cpp; OpenCV's imgcodecs only in tests)
   libceres-dev                                # Ceres 2.1 (brings SuiteSparse)
   libspdlog-dev libfmt-dev                    # spdlog 1.10 on the external fmt 9
   catch2                                      # Catch2 2.13
