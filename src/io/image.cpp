@@ -17,17 +17,27 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <vector>
 
 namespace rgbl {
 namespace {
 
 std::vector<unsigned char> read_bytes(const std::filesystem::path& file) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(file, ec);
+  if (ec) throw ParseError(file, 0, fmt::format("cannot tell the image's size: {}", ec.message()));
+  // 8 bytes a pixel: more than a stored (uncompressed) 16-bit colour PNG of the largest image
+  if (size > 8 * kMaxImagePixels) {
+    throw ParseError(file, 0, fmt::format("the file has {} bytes, more than an image rgbl reads can ({})", size,
+                                          8 * kMaxImagePixels));
+  }
   std::ifstream in(file, std::ios::binary);
   if (!in) throw ParseError(file, 0, "cannot open the image");
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw ParseError(file, 0, "cannot read the image");
+  std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+  // one read of the known size: a stream iterator took a quarter of the decode time
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size))) {  // NOLINT
+    throw ParseError(file, 0, fmt::format("cannot read the image's {} bytes", size));
+  }
   return bytes;
 }
 
