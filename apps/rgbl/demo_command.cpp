@@ -1,5 +1,5 @@
-// rgbl demo [--scenario NAME|list] [--frames N] [--path straight|curve|loop] [--laps N] [--seed S] [--depth SPEC]
-//           [--out DIR] [--no-loop-closing]
+// rgbl demo [--scenario NAME|list] [--frames N] [--path straight|curve|loop] [--laps N] [--lap-offset M]
+//           [--seed S] [--depth SPEC] [--out DIR] [--no-loop-closing]
 //           [--keep DIR]
 // The main job without a dataset: generates a synthetic street (rgbl::sim) in the KITTI odometry layout
 // and tracks it through exactly the code of `rgbl run` (rgbl::Pipeline), so the accuracy
@@ -134,6 +134,10 @@ Command add_demo_command(CLI::App& parent) {
                                         "(default: a temporary folder, removed afterwards)");
   app->add_option("--laps", args->demo.laps, "Laps of --path loop in the frames driven (2: past the start and round again)")
       ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  app->add_option("--lap-offset", args->demo.lap_offset,
+                  "Metres right (+) or left (-) of the first lap for the later laps of --path loop (-3.3: the "
+                  "next lane to the left), reached by a lane change ending 10 m before the start")
       ->capture_default_str();
   app->add_flag("--threaded", args->demo.threaded, "Local mapping and loop closing in threads of their own");
   app->add_flag_callback("--no-loop-closing", [args] { args->demo.loop_closing = false; }, "Track without loop closing (to compare)");

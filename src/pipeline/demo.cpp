@@ -16,6 +16,9 @@ void DemoOptions::validate() const {
   if (laps != 1 && (!scenario.empty() || path != "loop")) {
     throw ConfigError("laps", "1 except on the loop path (the other paths and the scenarios do not come back)");
   }
+  if (lap_offset != 0.0 && laps < 2) {
+    throw ConfigError("lap_offset", "0 unless a loop of 2 or more laps is driven (the offset is the later laps')");
+  }
   // refused before any generation time is spent on it
   if (builtin_depth_sources().entry(depth).needs.depth_image) {
     throw ConfigError("depth", fmt::format("lidar[:...], stereo or precomputed[:<dir>] for the demo's KITTI layout "
@@ -36,7 +39,10 @@ SyntheticOptions demo_simulation(const DemoOptions& options) {
     sim.path.kind = *parse_path_kind(options.path);
   }
   sim.depth_camera = 0;  // the exact depth of the camera the pipeline tracks
-  if (sim.path.kind == PathKind::loop) fit_loop(sim, options.laps);
+  if (sim.path.kind == PathKind::loop) {
+    fit_loop(sim, options.laps);
+    sim.path.loop_lap_offset = options.lap_offset;
+  }
   const DepthSourceNeeds needs = builtin_depth_sources().entry(options.depth).needs;
   sim.cameras = {true, needs.right_image, false, false};
   sim.render_depth = options.depth == "precomputed";

@@ -53,6 +53,9 @@ void PathOptions::validate() const {
   require(bend_straight >= 0.0, "path.bend_straight", "a length >= 0 m");
   require(loop_corner_radius >= 12.0, "path.loop_corner_radius", "a radius of at least 12 m");
   require(loop_laps >= 1 && loop_laps <= 100, "path.loop_laps", "1..100 laps");
+  require(std::isfinite(loop_lap_offset) && std::abs(loop_lap_offset) <= 6.0, "path.loop_lap_offset",
+          "an offset of at most 6 m either side");
+  require(loop_lap_change >= 10.0 && loop_lap_change <= 200.0, "path.loop_lap_change", "10..200 m");
   require(std::isfinite(turn_start) && turn_start >= 0.0, "path.turn_start", "a length >= 0 m");
   require(turn_radius >= 8.0 && turn_radius <= 1000.0, "path.turn_radius", "a radius in [8, 1000] m");
   require(turn_angle_deg != 0.0 && std::abs(turn_angle_deg) <= 180.0, "path.turn_angle_deg",
@@ -135,6 +138,10 @@ DrivePath::DrivePath(const PathOptions& options, double length) {
         if (side > 0.0) segments_.push_back({i < 3 ? side : 0.5 * side, 0.0});
       }
       closed_ = true;
+      lap_offset_ = options.loop_lap_offset;
+      lap_change_ = options.loop_lap_change;
+      require(lap_offset_ == 0.0 || length >= lap_change_ + 20.0, "path.loop_lap_change",
+              "a lane change that fits into the first lap with 10 m to spare at either end");
       break;
     }
   }
@@ -189,8 +196,28 @@ Eigen::Vector2d DrivePath::point(double s, double lateral) const {
   return Eigen::Vector2d(p.x, p.z) + lateral * p.right();
 }
 
+double DrivePath::camera_offset(double s) const {
+  if (lap_offset_ == 0.0) return 0.0;
+  // a smoothstep from the first lap's track to the offset, ending 10 m before the start
+  const double t = std::clamp((s - (total_length_ - 10.0 - lap_change_)) / lap_change_, 0.0, 1.0);
+  return lap_offset_ * t * t * (3.0 - 2.0 * t);
+}
+
 Eigen::Isometry3d DrivePath::pose(double s) const {
-  const PathPoint p = at(s);
+  PathPoint p = at(s);
+  constexpr double h = 0.005;
+  const double offset = camera_offset(s), behind = camera_offset(s - h), ahead = camera_offset(s + h);
+  if (offset != 0.0 || behind != 0.0 || ahead != 0.0) {
+    const Eigen::Vector2d here = point(s, offset);
+    if (behind != ahead) {
+      // in the lane change: heading along the camera's own motion, by a central difference over 1 cm
+      // (the change turns the car by at most atan(1.5 offset / change), 9 deg for 3.3 m over 30 m)
+      const Eigen::Vector2d step = point(s + h, ahead) - point(s - h, behind);
+      p.heading = std::atan2(step.x(), step.y());
+    }
+    p.x = here.x();
+    p.z = here.y();
+  }
   const double c = std::cos(p.heading), sn = std::sin(p.heading);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() << c, 0.0, sn, 0.0, 1.0, 0.0, -sn, 0.0, c;

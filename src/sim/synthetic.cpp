@@ -397,6 +397,8 @@ void SyntheticOptions::validate() const {
     require(driven_length() / path.loop_laps >= 2.0 * std::numbers::pi * path.loop_corner_radius, "frames",
             "enough frames for the loop: (frames - 1) * speed * frame_period >= path.loop_laps * 2 pi "
             "path.loop_corner_radius");
+    require(std::abs(scene.lane_offset + path.loop_lap_offset) <= scene.road_half_width - scene.parking_width - 1.0,
+            "path.loop_lap_offset", "an offset that keeps the camera 1 m inside the driving lanes");
   }
   if (untextured) {
     require(untextured->first >= 0 && untextured->first <= untextured->last && untextured->last < frames, "untextured",

@@ -326,6 +326,9 @@ TEST_CASE("the demo as a library: a scenario or a path, only the sensors its dep
   CHECK(two_laps.frames == 160);  // 80 per lap by default
   CHECK(two_laps.path.kind == rgbl::PathKind::loop);
   CHECK(two_laps.cameras == std::array<bool, 4>{true, true, false, false});  // stereo reads the right image
+  CHECK(two_laps.path.loop_lap_offset == 0.0);
+  loop.lap_offset = -3.3;
+  CHECK(rgbl::demo_simulation(loop).path.loop_lap_offset == -3.3);
 
   // every refusal names the key, before anything is generated
   const auto refused = [](rgbl::DemoOptions o, const char* key) {
@@ -351,6 +354,13 @@ TEST_CASE("the demo as a library: a scenario or a path, only the sensors its dep
   bad = {};
   bad.frames = -1;
   refused(bad, "frames");
+  bad = {};
+  bad.path = "loop";
+  bad.lap_offset = -3.3;  // one lap has no later laps
+  refused(bad, "lap_offset");
+  bad.laps = 2;
+  bad.lap_offset = 2.0;  // into the parking lane
+  refused(bad, "path.loop_lap_offset");
 
   // `precomputed` alone tracks with the exact depth images the generator writes
   rgbl::test::TempDir dir;

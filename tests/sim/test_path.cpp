@@ -107,6 +107,46 @@ TEST_CASE("a loop of two laps passes its start at half the frames and drives the
   CHECK_THROWS_WITH(options.validate(), Contains("path.loop_laps"));
 }
 
+TEST_CASE("a loop's later laps a lane to the side: the same track shifted, a smooth lane change before the start") {
+  rgbl::SyntheticOptions options;
+  options.frames = 241;  // two laps of 120 m
+  options.path.kind = rgbl::PathKind::loop;
+  options.path.loop_laps = 2;
+  const rgbl::SyntheticGenerator same(options);
+  options.path.loop_lap_offset = -3.3;  // the next lane to the left
+  const rgbl::SyntheticGenerator offset(options);
+  const rgbl::DrivePath& path = offset.path();
+  // the first lap up to the lane change (it starts 40 m before the start) is the plain loop's, to the bit
+  for (int i = 0; i < 80; ++i) REQUIRE(offset.pose(i).isApprox(same.pose(i), 0.0));
+  // after the change (it ends 10 m before the start) every pose is the plain one moved 3.3 m left,
+  // with the same heading
+  for (int i = 111; i <= 240; ++i) {
+    const Eigen::Isometry3d a = same.pose(i), b = offset.pose(i);
+    const Eigen::Vector3d left = -a.linear().col(0);  // the camera's -x axis
+    REQUIRE((b.translation() - (a.translation() + 3.3 * left)).norm() < 1e-9);
+    REQUIRE(rgbl::rotation_angle(b.linear() * a.linear().transpose()) < 1e-6);
+  }
+  // in between the offset grows smoothly and the camera points where it moves
+  double previous = 0.0;
+  for (int i = 80; i <= 110; ++i) {
+    const double s = i * options.step();
+    const double o = path.camera_offset(s);
+    REQUIRE(o <= previous + 1e-12);
+    REQUIRE(previous - o < 3.3 * 1.5 / 30.0 + 1e-9);  // the smoothstep's steepest slope, per metre
+    previous = o;
+    const Eigen::Vector3d motion = offset.pose_at((i + 0.01) * options.frame_period).translation() -
+                                   offset.pose_at((i - 0.01) * options.frame_period).translation();
+    REQUIRE(std::acos(motion.normalized().dot(offset.pose(i).linear().col(2))) < 1e-4);
+  }
+  CHECK(previous == -3.3);
+  // a lane outside the road, or a change longer than the lap, is refused
+  options.path.loop_lap_offset = 1.0;  // 1.65 m right of the centreline + 1 m: into the parking lane
+  CHECK_THROWS_WITH(options.validate(), Contains("path.loop_lap_offset"));
+  options.path.loop_lap_offset = -3.3;
+  options.path.loop_lap_change = 110.0;
+  CHECK_THROWS_WITH(rgbl::SyntheticGenerator(options), Contains("path.loop_lap_change"));
+}
+
 TEST_CASE("a loop needs enough frames for its corners") {
   rgbl::SyntheticOptions options;
   options.path.kind = rgbl::PathKind::loop;

@@ -18,6 +18,7 @@ struct DemoOptions {
   std::string path = "curve";   // straight, curve, loop or turn, without a scenario
   int frames = 0;               // 0: a scenario's own; on a path 60, or 80 per lap of a loop
   int laps = 1;                 // of a loop (2: past the start and round again)
+  double lap_offset = 0.0;      // m right (+) or left (-) of the first lap for the later laps of a loop
   std::uint64_t seed = 1;       // of the scene and all noise
   // A depth spec as for PipelineOptions::depth, of a source that needs no depth camera (the layout has
   // none); `precomputed` alone tracks with the generator's exact depth images.
@@ -25,7 +26,7 @@ struct DemoOptions {
   bool threaded = false;
   bool loop_closing = true;
 
-  // Throws ConfigError naming the key (scenario, path, frames, laps, depth).
+  // Throws ConfigError naming the key (scenario, path, frames, laps, lap_offset, depth).
   void validate() const;
 };
 

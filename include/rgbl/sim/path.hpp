@@ -33,6 +33,11 @@ struct PathOptions {
   double bend_straight = 30.0;      // m of straight before each bend of "curve"
   double loop_corner_radius = 15.0; // m, radius of the four corners of "loop"
   int loop_laps = 1;                // laps of "loop" in the driven length (2: the start is passed once)
+  // The later laps of "loop" a lane to the side: metres right (+) or left (-) of the first lap's
+  // track, reached by a lane change over `loop_lap_change` m that ends 10 m before the start. 0: every
+  // lap on the same track (the viewpoints repeat to within a frame's step).
+  double loop_lap_offset = 0.0;
+  double loop_lap_change = 30.0;
   double turn_start = 20.0;         // m of straight before the bend of "turn"
   double turn_radius = 12.0;        // m, radius of the bend of "turn" (of the camera's track)
   double turn_angle_deg = 90.0;     // > 0 turns left, < 0 right
@@ -97,8 +102,12 @@ class DrivePath {
   PathPoint at(double s) const;
   // Point at lateral offset `lateral` (metres, + = right of the driving direction) from the track.
   Eigen::Vector2d point(double s, double lateral) const;
-  // T_world_cam0 of a level camera on the track at arc length s (camera at y = 0).
+  // T_world_cam0 of a level camera on the track at arc length s (camera at y = 0), s counted from the
+  // start over all laps: on a loop with a lap offset the camera leaves the track (PathOptions), its
+  // heading along its own motion.
   Eigen::Isometry3d pose(double s) const;
+  // The camera's lateral offset from the track at arc length s (0 without a lap offset).
+  double camera_offset(double s) const;
 
  private:
   void build_starts();
@@ -108,6 +117,7 @@ class DrivePath {
   std::vector<double> start_s_;      // arc length at the start of each segment
   double total_length_ = 0.0;
   bool closed_ = false;
+  double lap_offset_ = 0.0, lap_change_ = 30.0;
 };
 
 }  // namespace rgbl
