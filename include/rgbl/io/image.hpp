@@ -13,7 +13,8 @@ namespace rgbl {
 enum class ImageMode { grey, colour, grey_any_depth };
 
 // Decodes a PNG or JPEG `file` to the pixels cv::imread gives for the same mode (libpng and libjpeg
-// set up as OpenCV 4.6 does), without OpenCV's imgcodecs. The file must be a readable regular file
+// set up as OpenCV 4.6 does; a JPEG's EXIF orientation is not applied, where cv::imread turns the
+// image by it), without OpenCV's imgcodecs. The file must be a readable regular file
 // and at most kMaxImagePixels large (checked on its header before decoding; see rgbl/core/file.hpp).
 // Throws ParseError naming the file otherwise or when it cannot be decoded; never returns an empty
 // image.
