@@ -10,6 +10,8 @@
 namespace rgbl {
 namespace {
 
+bool has_depth(const BundleObservation& o) { return o.depth > 0.0 && o.depth_sigma > 0.0; }
+
 // Parameter blocks: rotation of R_cam_world as angle-axis (3), t_cam_world (3), the point's world
 // position (3). Every residual has three rows, the third zero without depth: with all row and
 // parameter blocks of size 3 Ceres runs its fixed-size Schur eliminator (SchurEliminator<3, 3, 3>)
@@ -19,47 +21,28 @@ namespace {
 class ReprojectionDepthCost final : public ceres::SizedCostFunction<3, 3, 3, 3> {
  public:
   ReprojectionDepthCost(const PinholeCamera& camera, const BundleObservation& o)
-      : camera_(camera), pixel_(o.pixel), inv_sigma_px_(1.0 / o.sigma_px),
-        depth_(o.depth), inv_sigma_z_(o.depth > 0.0 && o.depth_sigma > 0.0 ? 1.0 / o.depth_sigma : 0.0) {}
+      : camera_(camera), pixel_(o.pixel), inv_sigma_px_(1.0 / o.sigma_px), depth_(o.depth),
+        inv_sigma_z_(has_depth(o) ? 1.0 / o.depth_sigma : 0.0) {}
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const Eigen::Map<const Eigen::Vector3d> w(parameters[0]), t(parameters[1]), x(parameters[2]);
-    const double theta2 = w.squaredNorm();
     const Eigen::Matrix3d R = so3_exp(w);
     const Eigen::Vector3d Rx = R * x;
     const Eigen::Vector3d p = Rx + t;
-    const double inv_z = 1.0 / p.z();
-    Eigen::Vector2d xn(p.x() * inv_z, p.y() * inv_z);
-    const Eigen::Vector2d xu = xn;
-    if (!camera_.distortion.is_zero()) camera_.distortion.apply(xn.x(), xn.y());
-    residuals[0] = (camera_.fx * xn.x() + camera_.cx - pixel_.x()) * inv_sigma_px_;
-    residuals[1] = (camera_.fy * xn.y() + camera_.cy - pixel_.y()) * inv_sigma_px_;
+    const Eigen::Vector2d px = camera_.project_unchecked(p);
+    residuals[0] = (px.x() - pixel_.x()) * inv_sigma_px_;
+    residuals[1] = (px.y() - pixel_.y()) * inv_sigma_px_;
     residuals[2] = inv_sigma_z_ > 0.0 ? (p.z() - depth_) * inv_sigma_z_ : 0.0;
     if (jacobians == nullptr) return true;
 
     // d(residual) / d(p): the whitened projection, then the depth row.
-    Eigen::Matrix<double, 2, 3> dxn_dp;
-    dxn_dp << inv_z, 0.0, -xu.x() * inv_z, 0.0, inv_z, -xu.y() * inv_z;
-    Eigen::Matrix2d K;
-    K << camera_.fx, 0.0, 0.0, camera_.fy;
-    if (!camera_.distortion.is_zero()) K = K * camera_.distortion.jacobian(xu.x(), xu.y());
     Eigen::Matrix3d dr_dp;
-    dr_dp.topRows<2>() = inv_sigma_px_ * K * dxn_dp;
+    dr_dp.topRows<2>() = inv_sigma_px_ * camera_.projection_jacobian(p);
     dr_dp.row(2) << 0.0, 0.0, inv_sigma_z_;
-
     using RowMajor3d = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
     if (jacobians[0] != nullptr) {
-      // R(w + dw) x = R x - hat(R x) J_l(w) dw, with J_l the left Jacobian of SO(3).
-      const Eigen::Matrix3d W = hat(w);
-      Eigen::Matrix3d J_l = Eigen::Matrix3d::Identity();
-      if (theta2 < 1e-10) {
-        J_l += 0.5 * W + (1.0 / 6.0) * W * W;
-      } else {
-        const double theta = std::sqrt(theta2);
-        J_l += ((1.0 - std::cos(theta)) / theta2) * W + ((theta - std::sin(theta)) / (theta2 * theta)) * W * W;
-      }
-      Eigen::Map<RowMajor3d> d_rotation(jacobians[0]);
-      d_rotation = -dr_dp * hat(Rx) * J_l;
+      // R(w + dw) x = R x - hat(R x) J_l(w) dw
+      Eigen::Map<RowMajor3d>{jacobians[0]} = -dr_dp * hat(Rx) * so3_left_jacobian(w);
     }
     if (jacobians[1] != nullptr) Eigen::Map<RowMajor3d>{jacobians[1]} = dr_dp;
     if (jacobians[2] != nullptr) Eigen::Map<RowMajor3d>{jacobians[2]} = dr_dp * R;
@@ -71,12 +54,6 @@ class ReprojectionDepthCost final : public ceres::SizedCostFunction<3, 3, 3, 3> 
   Eigen::Vector2d pixel_;
   double inv_sigma_px_, depth_, inv_sigma_z_;
 };
-
-bool has_depth(const BundleObservation& o) { return o.depth > 0.0 && o.depth_sigma > 0.0; }
-
-ceres::CostFunction* make_cost(const PinholeCamera& camera, const BundleObservation& o) {
-  return new ReprojectionDepthCost(camera, o);
-}
 
 class AbortCallback : public ceres::IterationCallback {
  public:
@@ -117,7 +94,7 @@ Eigen::Isometry3d parameters_to_pose(const Vector6d& parameters) {
 int bundle_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world, const Eigen::Vector3d& point,
                     const BundleObservation& observation, Eigen::Vector3d& residual,
                     Eigen::Matrix<double, 3, 6>& d_pose, Eigen::Matrix3d& d_point) {
-  const std::unique_ptr<ceres::CostFunction> cost(make_cost(camera, observation));
+  const auto cost = std::make_unique<ReprojectionDepthCost>(camera, observation);
   Vector6d pose = pose_to_parameters(T_cam_world);
   Eigen::Vector3d p = point;
   const double* parameters[3] = {pose.data(), pose.data() + 3, p.data()};
@@ -149,8 +126,8 @@ BundleAdjustmentResult bundle_adjust(const PinholeCamera& camera, BundleProblem&
     double* rotation = poses[static_cast<std::size_t>(o.pose)].data();
     double* translation = rotation + 3;
     double* point = problem.points[static_cast<std::size_t>(o.point)].data();
-    ceres_problem.AddResidualBlock(make_cost(camera, o), new ceres::HuberLoss(has_depth(o) ? delta3 : delta2),
-                                   rotation, translation, point);
+    ceres_problem.AddResidualBlock(new ReprojectionDepthCost(camera, o),
+                                   new ceres::HuberLoss(has_depth(o) ? delta3 : delta2), rotation, translation, point);
     if (!point_used[static_cast<std::size_t>(o.point)]) {
       point_used[static_cast<std::size_t>(o.point)] = true;
       ordering->AddElementToGroup(point, 0);

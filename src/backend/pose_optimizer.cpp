@@ -19,20 +19,13 @@ bool pose_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_w
   const Eigen::Vector3d p = T_cam_world * obs.p_world;
   dimension = obs.depth > 0.0 && obs.depth_sigma > 0.0 ? 3 : 2;
   if (p.z() <= 1e-6) return false;
-  const double iz = 1.0 / p.z();
   const Eigen::Vector2d uv = camera.project_unchecked(p);
   const double w = 1.0 / obs.sigma_px;
   residual(0) = (uv.x() - obs.pixel.x()) * w;
   residual(1) = (uv.y() - obs.pixel.y()) * w;
-  // d(u,v,z)/dp = K' * d(distorted)/d(normalised) * d(normalised)/dp
-  Eigen::Matrix<double, 2, 3> dnormalised;
-  dnormalised << iz, 0.0, -p.x() * iz * iz,  //
-      0.0, iz, -p.y() * iz * iz;
-  if (!camera.distortion.is_zero()) {
-    dnormalised = camera.distortion.jacobian(p.x() * iz, p.y() * iz) * dnormalised;
-  }
+  // d(u,v,z)/dp
   Eigen::Matrix3d dproj;
-  dproj.topRows<2>() = Eigen::Vector2d(camera.fx, camera.fy).asDiagonal() * dnormalised;
+  dproj.topRows<2>() = camera.projection_jacobian(p);
   dproj.row(2) << 0.0, 0.0, 1.0;
   // dp/dxi for a left perturbation: [I, -hat(p)]
   Eigen::Matrix<double, 3, 6> dp;

@@ -55,8 +55,7 @@ void RgbdSourceOptions::validate() const {
 }
 
 cv::Mat_<float> read_depth_png(const std::filesystem::path& file) {
-  require_image_file(file, "a depth PNG (uint16, depth x 256)");
-  const cv::Mat raw = read_image_file(file, ImageMode::grey_any_depth);
+  const cv::Mat raw = read_image_file(file, ImageMode::grey_any_depth, "a depth PNG (uint16, depth x 256)");
   if (raw.type() != CV_16UC1) throw ParseError(file, 0, "a single-channel uint16 PNG (depth x 256)");
   cv::Mat_<float> depth;
   raw.convertTo(depth, CV_32F, 1.0 / 256.0);

@@ -50,6 +50,16 @@ Eigen::Vector2d PinholeCamera::project_unchecked(const Eigen::Vector3d& p_cam) c
   return project_point(*this, p_cam.x(), p_cam.y(), p_cam.z());
 }
 
+Eigen::Matrix<double, 2, 3> PinholeCamera::projection_jacobian(const Eigen::Vector3d& p_cam) const {
+  // fx, fy times d(distorted) / d(normalised) times d(normalised) / d(p)
+  const double iz = 1.0 / p_cam.z();
+  Eigen::Matrix<double, 2, 3> dnormalised;
+  dnormalised << iz, 0.0, -p_cam.x() * iz * iz,  //
+      0.0, iz, -p_cam.y() * iz * iz;
+  if (!distortion.is_zero()) dnormalised = distortion.jacobian(p_cam.x() * iz, p_cam.y() * iz) * dnormalised;
+  return Eigen::Vector2d(fx, fy).asDiagonal() * dnormalised;
+}
+
 std::optional<Eigen::Vector2d> PinholeCamera::project(const Eigen::Vector3d& p_cam) const {
   if (!(p_cam.z() > 0.0)) return std::nullopt;
   const Eigen::Vector2d px = project_unchecked(p_cam);

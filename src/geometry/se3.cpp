@@ -5,7 +5,6 @@
 #include <limits>
 
 namespace rgbl {
-namespace {
 
 // Left Jacobian of SO(3) and its inverse, with Taylor expansions where the closed forms lose
 // precision (theta^2 below ~1e-10 makes the 1/theta^2 terms cancel catastrophically).
@@ -26,8 +25,6 @@ Eigen::Matrix3d so3_left_jacobian_inverse(const Eigen::Vector3d& phi) {
   const double c = (1.0 - theta * std::sin(theta) / (2.0 * (1.0 - std::cos(theta)))) / theta2;
   return Eigen::Matrix3d::Identity() - 0.5 * K + c * K * K;
 }
-
-}  // namespace
 
 Eigen::Matrix3d hat(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;

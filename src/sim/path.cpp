@@ -12,6 +12,8 @@ namespace {
 // Open paths are laid out this far beyond the requested length, so that the street ahead of the last
 // frame looks like the rest of it.
 constexpr double kOpenMargin = 150.0;
+// m between a loop's lane change (PathOptions::loop_lap_offset) and the start, and ahead of the change
+constexpr double kLapChangeMargin = 10.0;
 
 PathPoint advance(const PathPoint& p0, double curvature, double ds) {
   PathPoint p;
@@ -140,7 +142,7 @@ DrivePath::DrivePath(const PathOptions& options, double length) {
       closed_ = true;
       lap_offset_ = options.loop_lap_offset;
       lap_change_ = options.loop_lap_change;
-      require(lap_offset_ == 0.0 || length >= lap_change_ + 20.0, "path.loop_lap_change",
+      require(lap_offset_ == 0.0 || length >= lap_change_ + 2.0 * kLapChangeMargin, "path.loop_lap_change",
               "a lane change that fits into the first lap with 10 m to spare at either end");
       break;
     }
@@ -198,8 +200,8 @@ Eigen::Vector2d DrivePath::point(double s, double lateral) const {
 
 double DrivePath::camera_offset(double s) const {
   if (lap_offset_ == 0.0) return 0.0;
-  // a smoothstep from the first lap's track to the offset, ending 10 m before the start
-  const double t = std::clamp((s - (total_length_ - 10.0 - lap_change_)) / lap_change_, 0.0, 1.0);
+  // a smoothstep from the first lap's track to the offset, ending kLapChangeMargin before the start
+  const double t = std::clamp((s - (total_length_ - kLapChangeMargin - lap_change_)) / lap_change_, 0.0, 1.0);
   return lap_offset_ * t * t * (3.0 - 2.0 * t);
 }
 

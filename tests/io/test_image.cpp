@@ -75,8 +75,8 @@ TEST_CASE("synthetic PNGs and JPEGs of every layout decode to cv::imread's pixel
     REQUIRE(cv::imwrite(file.string(), random_image(37, 53, type, static_cast<unsigned>(++index))));
     check_same_as_opencv(file);
   }
-  // an interlaced, palette, 1-bit grey: written by libpng through OpenCV's options is not possible,
-  // so the JPEGs complete the set: grey and colour, baseline and progressive
+  // (cv::imwrite writes no interlaced, palette or 1-bit PNG, so those layouts are not compared here)
+  // JPEGs: grey and colour, baseline and progressive
   for (const int type : {CV_8UC1, CV_8UC3}) {
     for (const int progressive : {0, 1}) {
       const auto file = dir.path() / ("image" + std::to_string(++index) + ".jpg");

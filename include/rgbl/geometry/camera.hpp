@@ -49,6 +49,8 @@ struct PinholeCamera {
   std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& p_cam) const;
   // Pixel without visibility checks; z must be non-zero.
   Eigen::Vector2d project_unchecked(const Eigen::Vector3d& p_cam) const;
+  // d(project_unchecked) / d(p_cam), lens distortion included; z must be non-zero.
+  Eigen::Matrix<double, 2, 3> projection_jacobian(const Eigen::Vector3d& p_cam) const;
   // Point at camera depth z (along the optical axis) seen at pixel px.
   Eigen::Vector3d unproject(const Eigen::Vector2d& px, double z) const;
 

@@ -15,6 +15,10 @@ using Matrix34d = Eigen::Matrix<double, 3, 4>;
 Eigen::Matrix3d hat(const Eigen::Vector3d& v);
 
 Eigen::Matrix3d so3_exp(const Eigen::Vector3d& phi);
+// Left Jacobian of SO(3): so3_exp(phi + d) ~ so3_exp(so3_left_jacobian(phi) * d) * so3_exp(phi); and its
+// inverse. Taylor expansions near phi = 0.
+Eigen::Matrix3d so3_left_jacobian(const Eigen::Vector3d& phi);
+Eigen::Matrix3d so3_left_jacobian_inverse(const Eigen::Vector3d& phi);
 // Rotation vector of R, angle in [0, pi]; stable near 0 and pi.
 Eigen::Vector3d so3_log(const Eigen::Matrix3d& R);
 

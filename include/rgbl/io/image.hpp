@@ -4,6 +4,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include <filesystem>
+#include <string_view>
 #include <vector>
 
 namespace rgbl {
@@ -16,9 +17,10 @@ enum class ImageMode { grey, colour, grey_any_depth };
 // set up as OpenCV 4.6 does; a JPEG's EXIF orientation is not applied, where cv::imread turns the
 // image by it), without OpenCV's imgcodecs. The file must be a readable regular file
 // and at most kMaxImagePixels large (checked on its header before decoding; see rgbl/core/file.hpp).
-// Throws ParseError naming the file otherwise or when it cannot be decoded; never returns an empty
-// image.
-cv::Mat read_image_file(const std::filesystem::path& file, ImageMode mode);
+// Throws ParseError naming the file (and `what` it was expected to be) otherwise or when it cannot be
+// decoded; never returns an empty image.
+cv::Mat read_image_file(const std::filesystem::path& file, ImageMode mode,
+                        std::string_view what = "an image file");
 
 // `image` (8- or 16-bit; 1, 3 (BGR) or 4 (BGRA) channels) as the bytes of a PNG file. Throws Error
 // for other images.
