@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Two builds compared over several samples of the accuracy suite, not over one. A tracking run is
+# chaotic: a change that moves a few keypoints by a pixel sends a 51-frame drive to another of its
+# outcomes, which differ by more than most changes do (docs/accuracy.md, "One table is one sample").
+# Each sample runs the suite with another ORBextractor.nFeatures (default 1800 1900 2000 2100 2200);
+# per run, the script prints both builds' mean ATE over the samples and how often B beat A.
+#
+#   scripts/ab-table.sh --a BUILD_DIR --b BUILD_DIR [--features "1800 ... 2200"] [--out DIR]
+#                       [-- ARGS for scripts/accuracy.sh, e.g. --no-variants --scenarios "traffic"]
+#
+# Each build directory needs bin/rgbl and bin/rgbl_accuracy_table. The full suite takes about 5 min
+# per sample and build on 2 cores (50 min for the defaults); --no-variants about 3.
+set -euo pipefail
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+a=""
+b=""
+features="1800 1900 2000 2100 2200"
+out="$repo/build/ab"
+suite=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --a) a="$2"; shift 2 ;;
+    --b) b="$2"; shift 2 ;;
+    --features) features="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    --) shift; suite=("$@"); break ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    *) echo "ab-table: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+[ -n "$a" ] && [ -n "$b" ] || { echo "ab-table: give both builds, --a DIR --b DIR" >&2; exit 2; }
+a="$(cd "$a" && pwd)"
+b="$(cd "$b" && pwd)"
+for build in "$a" "$b"; do
+  for tool in rgbl rgbl_accuracy_table; do
+    [ -x "$build/bin/$tool" ] || { echo "ab-table: $build/bin/$tool not built" >&2; exit 2; }
+  done
+done
+mkdir -p "$out"
+for n in $features; do
+  case "$n" in ''|*[!0-9]*) echo "ab-table: --features takes whole numbers, got '$n'" >&2; exit 2 ;; esac
+  config="$out/features-$n.yaml"
+  printf '%%YAML:1.0\nORBextractor.nFeatures: %d\n' "$n" > "$config"
+  for side in a b; do
+    build="$a"
+    [ "$side" = b ] && build="$b"
+    echo "ab-table: nFeatures $n, build $side ($build)"
+    # no baseline to compare with; each sample's figures are saved for the summary
+    "$repo/scripts/accuracy.sh" --build "$build" --out "$out/$side-$n" --baseline "$out/none.json" \
+        --save-baseline "$out/$side-$n.json" "${suite[@]}" -- --config "$config" > "$out/$side-$n.log" 2>&1 ||
+      { echo "ab-table: the suite failed, see $out/$side-$n.log" >&2; exit 1; }
+  done
+done
+# shellcheck disable=SC2086  # the sample list is split on purpose
+python3 "$repo/scripts/ab_table.py" "$out" $features | tee "$out/summary.md"
