@@ -5,7 +5,7 @@
 # difference to a saved baseline. Judge every tracking change on the whole table.
 #
 #   scripts/accuracy.sh [--build DIR] [--out DIR] [--seeds "1 2 3"] [--frames N] [--scenarios "a b"]
-#                       [--baseline FILE] [--save-baseline FILE] [--no-real] [--no-variants] [--no-sim]
+#                       [--baseline FILE | --no-baseline] [--save-baseline FILE] [--no-real] [--no-variants] [--no-sim]
 #                       [-- ARGS for rgbl run, e.g. --threaded --realtime]
 #
 # Each scenario runs at its default length (`rgbl demo --scenario list`) unless --frames is given; the
@@ -40,6 +40,7 @@ while [ $# -gt 0 ]; do
     --frames) frames="$2"; shift 2 ;;
     --scenarios) scenarios="$2"; shift 2 ;;
     --baseline) baseline="$2"; shift 2 ;;
+    --no-baseline) baseline=""; shift ;;
     --save-baseline) save="$2"; shift 2 ;;
     --no-real) real=0; shift ;;
     --no-variants) variants=0; shift ;;
@@ -163,7 +164,7 @@ fi
 
 echo
 table_args=("$out/runs")
-[ -f "$baseline" ] && table_args+=(--baseline "$baseline")
+[ -n "$baseline" ] && [ -f "$baseline" ] && table_args+=(--baseline "$baseline")
 [ -n "$save" ] && table_args+=(--save-baseline "$save")
 "$table" "${table_args[@]}" | tee "$out/table.md"
 echo

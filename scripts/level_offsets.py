@@ -43,10 +43,20 @@ def main():
     def image(i):
         return cv2.imread(str(seq / "image_0" / f"{i:06d}.png"), cv2.IMREAD_GRAYSCALE)
 
-    first = image(0)
-    height, width = first.shape
-    scales = [options.scale_factor ** level for level in range(options.num_levels)]
-    sizes = [(round(width / s), round(height / s)) for s in scales]
+    extracted = {}
+
+    def extract(i):  # each frame is the target of up to four pairs
+        if i not in extracted:
+            extracted[i] = extractor.extract(image(i))
+        return extracted[i]
+
+    height, width = image(0).shape
+    # the extractor's level sizes: float scales multiplied level by level, sizes rounded half away
+    scales = [np.float32(1.0)]
+    for _ in range(1, options.num_levels):
+        scales.append(np.float32(scales[-1] * np.float32(options.scale_factor)))
+    sizes = [(int(np.floor(np.float32(width) / s + np.float32(0.5))),
+              int(np.floor(np.float32(height) / s + np.float32(0.5)))) for s in scales]
 
     def level_pixel(x, y, level):
         # whichever map made (x, y), the level pixel is whole under it
@@ -59,12 +69,13 @@ def main():
     offsets = {}  # level -> [(dx, dy) under x * scale, (dx, dy) pixel-centre]
     frames = len(poses)
     for i in range(0, frames - 4, 2):
-        ka, da = extractor.extract(image(i))
+        ka, da = extract(i)
         depth = cv2.imread(str(seq / "depth" / f"{i:06d}.png"), cv2.IMREAD_ANYDEPTH).astype(np.float64) / 256.0
         level0 = ka["level"] == 0
         ka, da = ka[level0], np.ascontiguousarray(da[level0])
+        extracted.pop(i - 2, None)
         for k in range(1, 5):
-            kb, db = extractor.extract(image(i + k))
+            kb, db = extract(i + k)
             T_b_a = np.linalg.inv(T_world_cam(i + k)) @ T_world_cam(i)
             for m in matcher.match(da, np.ascontiguousarray(db)):
                 if m.distance > 40:
