@@ -2,7 +2,9 @@
 
 #include "rgbl/core/error.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace rgbl {
 
@@ -86,16 +88,98 @@ std::vector<bool> ScanAgreement::agreeing(const ScanSample& query, const Eigen::
   return flags;
 }
 
+double signed_rank_z(std::span<const double> differences) {
+  std::vector<double> d;
+  for (const double x : differences) {
+    if (x != 0.0) d.push_back(x);  // zeros carry no sign (Wilcoxon's convention: dropped)
+  }
+  const auto n = static_cast<double>(d.size());
+  if (d.empty()) return 0.0;
+  std::sort(d.begin(), d.end(), [](double x, double y) { return std::abs(x) < std::abs(y); });
+  double w_plus = 0.0, ties = 0.0;
+  for (std::size_t i = 0; i < d.size();) {
+    std::size_t j = i;
+    while (j < d.size() && std::abs(d[j]) == std::abs(d[i])) ++j;
+    const double rank = 0.5 * static_cast<double>(i + 1 + j);  // ranks i+1..j averaged
+    for (std::size_t k = i; k < j; ++k) w_plus += d[k] > 0.0 ? rank : 0.0;
+    const auto t = static_cast<double>(j - i);
+    ties += t * t * t - t;
+    i = j;
+  }
+  const double mean = n * (n + 1.0) / 4.0;
+  const double variance = n * (n + 1.0) * (2.0 * n + 1.0) / 24.0 - ties / 48.0;
+  return variance > 0.0 ? (w_plus - mean) / std::sqrt(variance) : 0.0;
+}
+
+std::vector<std::uint32_t> label_objects(const ScanSample& sample, double edge) {
+  require(std::isfinite(edge) && edge > 0.0, "label_objects: edge", "> 0 m");
+  const auto inv = static_cast<float>(1.0 / edge);
+  VoxelIndex index;
+  index.reserve(sample.points.size());
+  std::vector<VoxelKey> keys;  // slot -> voxel
+  std::vector<std::uint32_t> slot_of(sample.points.size());
+  for (std::size_t i = 0; i < sample.points.size(); ++i) {
+    const VoxelKey key = voxel_of(sample.points[i], inv);
+    const auto [slot, added] = index.emplace(key, static_cast<std::uint32_t>(keys.size()));
+    if (added) keys.push_back(key);
+    slot_of[i] = slot;
+  }
+  // union-find over the voxels, each joined with its 26 neighbours
+  std::vector<std::uint32_t> parent(keys.size());
+  std::iota(parent.begin(), parent.end(), 0U);
+  const auto root = [&](std::uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (std::uint32_t s = 0; s < keys.size(); ++s) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          const std::uint32_t t = index.find({keys[s].x + dx, keys[s].y + dy, keys[s].z + dz});
+          if (t == VoxelIndex::npos || t <= s) continue;  // each pair once
+          const std::uint32_t rs = root(s), rt = root(t);
+          if (rs != rt) parent[std::max(rs, rt)] = std::min(rs, rt);
+        }
+      }
+    }
+  }
+  // labels in order of the points' first appearance
+  std::vector<std::uint32_t> label_of_root(keys.size(), VoxelIndex::npos);
+  std::vector<std::uint32_t> labels(sample.points.size());
+  std::uint32_t next = 0;
+  for (std::size_t i = 0; i < sample.points.size(); ++i) {
+    std::uint32_t& label = label_of_root[root(slot_of[i])];
+    if (label == VoxelIndex::npos) label = next++;
+    labels[i] = label;
+  }
+  return labels;
+}
+
 ScanVote ScanAgreement::vote(const ScanSample& query, const Eigen::Isometry3d& T_reference_query_a,
-                             const Eigen::Isometry3d& T_reference_query_b) const {
+                             const Eigen::Isometry3d& T_reference_query_b,
+                             std::span<const std::uint32_t> objects) const {
+  require(objects.empty() || objects.size() == query.points.size(), "ScanAgreement::vote: objects",
+          "one label per point of the query");
   const std::vector<bool> a = agreeing(query, T_reference_query_a);
   const std::vector<bool> b = agreeing(query, T_reference_query_b);
   ScanVote vote;
+  std::vector<double> per_object;  // object -> its only_b - only_a
+  if (!objects.empty()) per_object.assign(*std::max_element(objects.begin(), objects.end()) + std::size_t{1}, 0.0);
   for (std::size_t i = 0; i < a.size(); ++i) {
-    vote.only_a += a[i] && !b[i] ? 1 : 0;
-    vote.only_b += b[i] && !a[i] ? 1 : 0;
+    const bool for_a = a[i] && !b[i], for_b = b[i] && !a[i];
+    vote.only_a += for_a ? 1 : 0;
+    vote.only_b += for_b ? 1 : 0;
+    if (!objects.empty()) per_object[objects[i]] += (for_b ? 1.0 : 0.0) - (for_a ? 1.0 : 0.0);
   }
+  if (!objects.empty()) vote.object_z = signed_rank_z(per_object);
   return vote;
+}
+
+int ScanVote::object_preference() const {
+  if (std::isnan(object_z)) return preference();
+  if (object_z > 3.0) return 1;
+  if (object_z < -3.0) return -1;
+  return 0;
 }
 
 int ScanVote::preference() const {

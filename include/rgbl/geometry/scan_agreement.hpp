@@ -13,6 +13,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
+#include <span>
 #include <vector>
 
 namespace rgbl {
@@ -34,13 +36,30 @@ struct ScanSample {
 
 ScanSample sample_scan(PointCloudView scan, const Eigen::Isometry3d& T_cam_lidar, const ScanSampleOptions& options);
 
+// The objects of a sample: points whose voxels (of edge `edge`) touch, even at a corner, share a label
+// (labels 0..n-1 in order of first appearance). What is one object to the scan is one surface to a
+// pose: a truck's face, a facade, a pole; its returns land or miss together.
+std::vector<std::uint32_t> label_objects(const ScanSample& sample, double edge);
+
+// Wilcoxon's signed-rank statistic of paired differences as a z-score (normal approximation, tied
+// magnitudes given their average rank, zeros dropped): > 0 when the positive ones rank higher. 0
+// without a nonzero difference.
+double signed_rank_z(std::span<const double> differences);
+
 // How the points of one sample vote between two poses of it against a reference: the points that
 // land on the reference under one pose and not under the other.
 struct ScanVote {
   std::size_t only_a = 0, only_b = 0;
+  // With objects: Wilcoxon's signed-rank statistic over the objects' differences (their only_b -
+  // only_a), as a z-score (normal approximation, ties averaged); NaN when counted without objects.
+  double object_z = std::numeric_limits<double>::quiet_NaN();
   // +1 for b, -1 for a, 0 when the discordant points do not favour one beyond chance:
   // |only_b - only_a| <= 3 sqrt(only_a + only_b) (McNemar's test for paired counts, at 3 sigma).
   int preference() const;
+  // The same with objects, not returns, as the independent units: |object_z| > 3. Two trucks' 139
+  // returns for their own motion are two pieces of evidence, not 139; the ranks still let a large
+  // object weigh more than a small one. Without objects, preference().
+  int object_preference() const;
 };
 
 // A reference sample indexed for "is a point within the tolerance" queries (voxels of twice that edge).
@@ -54,8 +73,9 @@ class ScanAgreement {
   // The same per point of `query`: whether it agrees.
   std::vector<bool> agreeing(const ScanSample& query, const Eigen::Isometry3d& T_reference_query) const;
   // The points of `query` for pose a against pose b (both T_reference_query).
+  // With `objects` (label_objects(query, ...)), the vote's object_z too.
   ScanVote vote(const ScanSample& query, const Eigen::Isometry3d& T_reference_query_a,
-                const Eigen::Isometry3d& T_reference_query_b) const;
+                const Eigen::Isometry3d& T_reference_query_b, std::span<const std::uint32_t> objects = {}) const;
 
  private:
   // Whether p (in the reference's frame) lies within the tolerance of a reference point.

@@ -106,13 +106,15 @@ class Tracker {
   struct LidarView {
     ScanAgreement last;
     ScanSample evidence;
+    std::vector<std::uint32_t> objects;  // label_objects(evidence), when a vote first needs them
   };
   // The view, built into `cache` on the first call; nullptr without scan_arbitration or either scan.
   const LidarView* lidar_view(std::optional<LidarView>& cache, const Frame& frame) const;
   // The LiDAR's say between two poses of `frame`: +1 for b, -1 for a, 0 when it is not decisive or it
-  // has no view. a and b name them in the log.
+  // has no view. a and b name them in the log. by_objects: decisive only with objects, not returns,
+  // as the independent units (ScanVote::object_preference).
   int lidar_preference(std::optional<LidarView>& cache, const Frame& frame, const Eigen::Isometry3d& T_a_world,
-                       const Eigen::Isometry3d& T_b_world, const char* a, const char* b) const;
+                       const Eigen::Isometry3d& T_b_world, const char* a, const char* b, bool by_objects) const;
   // The LiDAR's own start for `frame` (see TrackerOptions::lidar_start_max_speed) as T_cur_last.
   std::optional<Eigen::Isometry3d> lidar_start(std::optional<LidarView>& cache, const Frame& frame) const;
   // A step beyond a vehicle's reach on weak evidence: the local map searched from the prediction
