@@ -1,6 +1,9 @@
 #!/usr/bin/env python3
 """Summary of scripts/ab-table.sh: per run, both builds' mean ATE over the samples and how often B
-was better, then the geometric mean ratio B / A per group of runs.
+was better, then the geometric mean ratio B / A per group of runs, then per scenario run and build
+its ATE as a multiple of the plain street's (same seed and frame count, as rgbl_accuracy_table pairs
+them) over the samples: the ratio of the means and in how many samples the ratio passed 1.5 (issue
+13's bar), which one table cannot tell from noise.
 
 Usage: ab_table.py OUT_DIR SAMPLE...   (reads OUT_DIR/a-SAMPLE.json and OUT_DIR/b-SAMPLE.json)
 """
@@ -21,6 +24,39 @@ def group_of(run):
     if run.startswith("real-"):
         return "real drives" if run.count("-") == 2 else "real, degraded variants"
     return "plain street" if run.startswith("plain") else "stress scenarios"
+
+
+def scenario_seed(run):
+    """("traffic", "1") for "traffic-s1"; None for a real drive."""
+    if run.startswith("real-") or "-s" not in run:
+        return None
+    scenario, seed = run.rsplit("-s", 1)
+    return (scenario, seed) if seed.isdigit() else None
+
+
+def plain_ratios(tables, runs, bar=1.5):
+    """Per scenario run (not the plain street): ratio of the mean ATEs to its plain street's, every
+    sample's ratio, and how many exceed the bar."""
+    plain = {}  # (seed, frames) -> run
+    for run in runs:
+        ss = scenario_seed(run)
+        if ss and (ss[0] == "plain" or ss[0].startswith("plain@")):
+            plain[(ss[1], tables[0][run]["frames"])] = run
+    rows = []
+    for run in runs:
+        ss = scenario_seed(run)
+        if not ss or ss[0] == "plain" or ss[0].startswith("plain@"):
+            continue
+        ref = plain.get((ss[1], tables[0][run]["frames"]))
+        if ref is None:
+            continue
+        ate = [t[run]["ate_rmse_m"] for t in tables]
+        ref_ate = [t[ref]["ate_rmse_m"] for t in tables]
+        if min(ref_ate) <= 0.0:
+            continue
+        each = [x / y for x, y in zip(ate, ref_ate)]
+        rows.append((run, ref, sum(ate) / sum(ref_ate), each, sum(1 for r in each if r > bar)))
+    return rows
 
 
 def main():
@@ -49,6 +85,18 @@ def main():
     for group, values in sorted(ratios.items()):
         geo = math.exp(sum(math.log(v) for v in values) / len(values))
         print(f"| {group} | {len(values)} | {geo:.3f} |")
+    for name, tables in (("A", a), ("B", b)):
+        rows = plain_ratios(tables, runs)
+        if not rows:
+            continue
+        over = sum(1 for r in rows if r[2] > 1.5)
+        print(f"\nBuild {name}: ATE as a multiple of the plain street's over the samples ({over} of {len(rows)} "
+              "runs above 1.5 on the ratio of the means)\n")
+        print("| run | plain | ratio of the mean ATEs | per sample | samples above 1.5 |")
+        print("|---|---|---|---|---|")
+        for run, ref, ratio, each, n_over in rows:
+            flag = " !" if ratio > 1.5 else ""
+            print(f"| {run} | {ref} | {ratio:.2f}{flag} | {' '.join(f'{r:.2f}' for r in each)} | {n_over} of {len(each)} |")
 
 
 if __name__ == "__main__":

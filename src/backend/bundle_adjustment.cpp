@@ -3,6 +3,7 @@
 #include "rgbl/core/error.hpp"
 
 #include <ceres/ceres.h>
+#include <ceres/rotation.h>
 
 #include <cmath>
 #include <memory>
@@ -53,6 +54,40 @@ class ReprojectionDepthCost final : public ceres::SizedCostFunction<3, 3, 3, 3> 
   PinholeCamera camera_;
   Eigen::Vector2d pixel_;
   double inv_sigma_px_, depth_, inv_sigma_z_;
+};
+
+// BundlePlanePair's residual. Automatic differentiation: a handful per problem.
+struct PlanePairCost {
+  Eigen::Vector4d a, b;
+  Eigen::Vector3d b1, b2;  // across b's normal
+  double inv_tilt, inv_offset;
+
+  PlanePairCost(const BundlePlanePair& pair) : a(pair.plane_a), b(pair.plane_b) {
+    const Eigen::Vector3d m = b.head<3>().normalized();
+    const Eigen::Vector3d axis = std::abs(m.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitZ();
+    b1 = (axis - axis.dot(m) * m).normalized();
+    b2 = m.cross(b1);
+    inv_tilt = 1.0 / pair.sigma_tilt;
+    inv_offset = 1.0 / pair.sigma_offset;
+  }
+
+  template <typename T>
+  bool operator()(const T* wa, const T* ta, const T* wb, const T* tb, T* residual) const {
+    // a's plane in the world: n_w = R_a^T n_a, d_w = d_a - n_a . t_a
+    const T na[3] = {T(a.x()), T(a.y()), T(a.z())};
+    const T minus_wa[3] = {-wa[0], -wa[1], -wa[2]};
+    T nw[3];
+    ceres::AngleAxisRotatePoint(minus_wa, na, nw);
+    const T dw = T(a.w()) - (na[0] * ta[0] + na[1] * ta[1] + na[2] * ta[2]);
+    // seen from b: n = R_b n_w, d = d_w + n . t_b
+    T n[3];
+    ceres::AngleAxisRotatePoint(wb, nw, n);
+    const T d = dw + n[0] * tb[0] + n[1] * tb[1] + n[2] * tb[2];
+    residual[0] = (T(b1.x()) * n[0] + T(b1.y()) * n[1] + T(b1.z()) * n[2]) * inv_tilt;
+    residual[1] = (T(b2.x()) * n[0] + T(b2.y()) * n[1] + T(b2.z()) * n[2]) * inv_tilt;
+    residual[2] = (d - T(b.w())) * inv_offset;
+    return true;
+  }
 };
 
 class AbortCallback : public ceres::IterationCallback {
@@ -141,6 +176,14 @@ BundleAdjustmentResult bundle_adjust(const PinholeCamera& camera, BundleProblem&
         ceres_problem.SetParameterBlockConstant(translation);
       }
     }
+  }
+
+  for (const BundlePlanePair& pair : problem.plane_pairs) {
+    const auto ia = static_cast<std::size_t>(pair.pose_a), ib = static_cast<std::size_t>(pair.pose_b);
+    if (ia >= poses.size() || ib >= poses.size() || ia == ib || !pose_used[ia] || !pose_used[ib]) continue;
+    ceres_problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlanePairCost, 3, 3, 3, 3, 3>(new PlanePairCost(pair)),
+                                   new ceres::HuberLoss(delta3), poses[ia].data(), poses[ia].data() + 3,
+                                   poses[ib].data(), poses[ib].data() + 3);
   }
 
   ceres::Solver::Options solver_options;

@@ -4,6 +4,7 @@
 #include "rgbl/core/log.hpp"
 #include "rgbl/geometry/voxel_index.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -114,6 +115,42 @@ ScanSample scan_evidence(const ScanSample& sample, const TrackerOptions& options
     if (taken.emplace(voxel_of(sample.points[i], inv), 0).second) evidence.points.push_back(sample.points[i]);
   }
   return evidence;
+}
+
+std::optional<RoadPlane> road_plane(const ScanSample& sample, const TrackerOptions& options) {
+  std::vector<Eigen::Vector3d> points(sample.points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) points[i] = sample.points[i].cast<double>();
+  const std::vector<int> below = below_camera(points, options);
+  std::vector<int> fit_on;  // as scan_evidence: at most 2000 candidates for the RANSAC
+  const std::size_t stride = below.size() / 2000 + 1;
+  for (std::size_t k = 0; k < below.size(); k += stride) fit_on.push_back(below[k]);
+  const std::optional<GroundPlane> plane = fit_ground(points, fit_on, options);
+  if (!plane) return std::nullopt;
+  // least squares over every return on it: the plane through their centroid across their least spread
+  const std::vector<bool> ground = on_ground(points, below, *plane, options);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (const int i : below) {
+    if (!ground[static_cast<std::size_t>(i)]) continue;
+    mean += points[static_cast<std::size_t>(i)];
+    ++count;
+  }
+  if (count < options.ground_min_points) return std::nullopt;
+  mean /= count;
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const int i : below) {
+    if (!ground[static_cast<std::size_t>(i)]) continue;
+    const Eigen::Vector3d q = points[static_cast<std::size_t>(i)] - mean;
+    scatter += q * q.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+  Eigen::Vector3d n = solver.eigenvectors().col(0);  // the smallest eigenvalue's
+  if (n.y() < 0.0) n = -n;
+  RoadPlane road;
+  road.n = n;
+  road.d = n.dot(mean);
+  road.points = count;
+  return road;
 }
 
 std::vector<bool> ground_keypoints(const PinholeCamera& camera, const Frame& frame, const TrackerOptions& options) {

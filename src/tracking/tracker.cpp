@@ -22,7 +22,7 @@ namespace rgbl {
 namespace {
 
 // The frame's observations as a new keyframe (landmark links are added by the caller).
-Keyframe keyframe_from(const Frame& frame) {
+Keyframe keyframe_from(const Frame& frame, const TrackerOptions& options) {
   Keyframe kf;
   kf.frame_index = frame.index;
   kf.timestamp = frame.timestamp;
@@ -31,6 +31,10 @@ Keyframe keyframe_from(const Frame& frame) {
   kf.descriptors = frame.descriptors;
   kf.depth = frame.depth;
   kf.depth_sigma = frame.depth_sigma;
+  // the road under it, which ties it to the keyframes before it in local BA
+  if (frame.scan) {
+    if (const auto road = road_plane(*frame.scan, options)) kf.road = Eigen::Vector4d(road->n.x(), road->n.y(), road->n.z(), road->d);
+  }
   // a point on a moving object is no landmark: without usable depth, local mapping makes none from it
   for (std::size_t i = 0; i < frame.size(); ++i) {
     if (frame.is_moving(i)) kf.depth_sigma[i] = 0.0F;
@@ -501,7 +505,7 @@ bool Tracker::initialise(Frame& frame, const Eigen::Isometry3d& T_cam_world) {
   }
   frame.T_cam_world = T_cam_world;
   std::unique_lock lock(map_.mutex());
-  const KeyframeId id = map_.add_keyframe(keyframe_from(frame));
+  const KeyframeId id = map_.add_keyframe(keyframe_from(frame, options_));
   const Eigen::Isometry3d T_world_cam = frame.T_cam_world.inverse();
   for (std::size_t i = 0; i < frame.size(); ++i) {
     if (frame.depth_sigma[i] <= 0.0F) continue;
@@ -911,7 +915,7 @@ bool Tracker::need_keyframe(const Frame& frame, int inliers, bool mapping_idle) 
 
 KeyframeId Tracker::make_keyframe(const Frame& frame) {
   std::unique_lock lock(map_.mutex());
-  const KeyframeId id = map_.add_keyframe(keyframe_from(frame));
+  const KeyframeId id = map_.add_keyframe(keyframe_from(frame, options_));
   for (std::size_t i = 0; i < frame.size(); ++i) {
     if (frame.landmarks[i].valid() && !frame.outlier[i]) map_.add_observation(frame.landmarks[i], id, static_cast<int>(i));
   }

@@ -151,3 +151,64 @@ TEST_CASE("bundle adjustment stops when the abort flag is set") {
   CHECK(result.aborted);
   CHECK(result.iterations <= 2);
 }
+
+TEST_CASE("bundle adjustment: a road seen by two poses ties the second's height and tilt to the first") {
+  // Pose a (fixed) and pose b 8 m further, both over one road 1.65 m below the camera; b's points are
+  // seen by b alone, so nothing but the road ties b to a. b starts 0.4 m too high and pitched and
+  // rolled by 1.5 and 1 deg: the road brings height, pitch and roll back; what the road cannot see
+  // (along it, across it, the heading) stays as it was.
+  const auto camera = rgbl::test::kitti_camera();
+  const Eigen::Isometry3d T_a = Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d T_b_true = rgbl::make_isometry(rgbl::so3_exp({0.0, 0.03, 0.0}), Eigen::Vector3d(0.0, 0.0, -8.0));
+  const Eigen::Vector4d road_cam(0.0, 1.0, 0.0, 1.65);  // n . x = d in either camera (the road is flat)
+  // the same road in b's frame: the world plane y = 1.65 seen from T_b_true
+  const Eigen::Vector3d n_b = T_b_true.linear() * Eigen::Vector3d::UnitY();
+  const double d_b = 1.65 + n_b.dot(T_b_true.translation());
+  rgbl::BundleProblem problem;
+  problem.poses.push_back({T_a, true});
+  const Eigen::Isometry3d error = rgbl::make_isometry(rgbl::so3_exp({0.026, 0.0, 0.017}), Eigen::Vector3d(0.0, -0.4, 0.0));
+  problem.poses.push_back({error * T_b_true, false});
+  // every pose needs observations to be in the problem: a's points seen by a, b's by b
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int pose = 0; pose < 2; ++pose) {
+    const Eigen::Isometry3d& T = pose == 0 ? T_a : problem.poses[1].T_cam_world;
+    for (int k = 0; k < 40; ++k) {
+      const Eigen::Vector3d p_cam(6.0 * u(rng), 1.5 * u(rng), 12.0 + 8.0 * u(rng));
+      rgbl::BundleObservation o;
+      o.pose = pose;
+      o.point = static_cast<int>(problem.points.size());
+      o.pixel = camera.project_unchecked(p_cam);
+      o.depth = p_cam.z();
+      o.depth_sigma = 0.05;
+      problem.points.push_back(T.inverse() * p_cam);
+      problem.observations.push_back(o);
+    }
+  }
+  rgbl::BundlePlanePair pair;
+  pair.pose_a = 0;
+  pair.pose_b = 1;
+  pair.plane_a = road_cam;
+  pair.plane_b = Eigen::Vector4d(n_b.x(), n_b.y(), n_b.z(), d_b);
+  pair.sigma_tilt = 0.5 * M_PI / 180.0;
+  pair.sigma_offset = 0.05;
+  problem.plane_pairs.push_back(pair);
+  rgbl::BundleAdjustmentOptions options;
+  options.iterations = 50;
+  const std::vector<Eigen::Vector3d> points = problem.points;
+  rgbl::bundle_adjust(camera, problem, options);
+  // b's camera centre and axes in the world against the truth's
+  const Eigen::Isometry3d T_world_b = problem.poses[1].T_cam_world.inverse(), T_world_true = T_b_true.inverse();
+  const Eigen::Vector3d c = T_world_b.translation(), c_true = T_world_true.translation();
+  CHECK(c.y() == Approx(c_true.y()).margin(1e-4));   // height over the road
+  const Eigen::Vector3d down = T_world_b.linear().col(1), down_true = T_world_true.linear().col(1);
+  CHECK(std::acos(std::min(1.0, down.dot(down_true))) < 1e-4);  // pitch and roll: the camera's down axis
+  CHECK(problem.poses[0].T_cam_world.isApprox(T_a));  // a is fixed
+  // without the pair nothing moves b: its own points agree with it
+  problem.plane_pairs.clear();
+  problem.poses[1].T_cam_world = error * T_b_true;
+  problem.points = points;
+  const Eigen::Isometry3d before = problem.poses[1].T_cam_world;
+  rgbl::bundle_adjust(camera, problem, options);
+  CHECK((problem.poses[1].T_cam_world.inverse().translation() - before.inverse().translation()).norm() < 1e-6);
+}

@@ -257,3 +257,34 @@ TEST_CASE("scan evidence: the road's returns leave, the rest counts once per vox
   for (double y = -3.0; y < 0.5; y += 0.01) wall.points.emplace_back(0.0, y, 10.0);
   CHECK(rgbl::scan_evidence(wall, options).points.size() >= 11);
 }
+
+TEST_CASE("road plane: the least-squares plane of the road's returns, the camera's height and tilt") {
+  // Camera frame (y down): a road 1.65 m below the camera, pitched 2 deg (it rises ahead), every 10 cm,
+  // with a pole and a wall off it that must not bend the fit.
+  const double pitch = 2.0 * M_PI / 180.0;
+  const Eigen::Vector3d n(0.0, std::cos(pitch), std::sin(pitch));  // pointing down, tilted forward
+  rgbl::ScanSample sample;
+  for (double x = -8.0; x <= 8.0; x += 0.1) {
+    for (double z = 3.0; z <= 30.0; z += 0.1) {
+      // the point (x, y, z) with n . p = 1.65
+      const double y = (1.65 - n.z() * z) / n.y();
+      sample.points.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+    }
+  }
+  for (double y = -3.0; y < 1.0; y += 0.01) sample.points.emplace_back(5.0F, static_cast<float>(y), 10.0F);
+  for (double x = -8.0; x <= 8.0; x += 0.05) {
+    for (double y = -3.0; y < 0.5; y += 0.05) sample.points.emplace_back(static_cast<float>(x), static_cast<float>(y), 35.0F);
+  }
+  const rgbl::TrackerOptions options;
+  const std::optional<rgbl::RoadPlane> road = rgbl::road_plane(sample, options);
+  REQUIRE(road);
+  CHECK(road->n.dot(n) == Approx(1.0).margin(1e-9));  // float coordinates: ~1e-7 m of noise
+  CHECK(road->d == Approx(1.65).margin(1e-5));
+  // every return of the road up to where it rises to ground_min_height (0.8 m) below the camera:
+  // 161 across, z = 3 .. 24.3 m (214 rows)
+  CHECK(road->points == Approx(161 * 214).margin(161));
+  // a scan without a road under the camera has none
+  rgbl::ScanSample wall;
+  for (double y = -3.0; y < 0.5; y += 0.01) wall.points.emplace_back(0.0F, static_cast<float>(y), 10.0F);
+  CHECK_FALSE(rgbl::road_plane(wall, options));
+}

@@ -28,10 +28,20 @@ struct BundleObservation {
   double depth_sigma = 0.0;
 };
 
+// Two poses that see one plane (the road under a car, in their LiDAR scans): plane_a and plane_b,
+// (n, d) of n . x = d in each camera frame, must be the same plane in the world. Three residuals in
+// b's frame: the tilt between b's plane and a's seen from b (2, whitened by sigma_tilt, rad) and the
+// offset (m, by sigma_offset), Huber-robust like a depth observation.
+struct BundlePlanePair {
+  int pose_a = 0, pose_b = 0;
+  Eigen::Vector4d plane_a = Eigen::Vector4d::UnitY(), plane_b = Eigen::Vector4d::UnitY();
+  double sigma_tilt = 0.01, sigma_offset = 0.05;
+};
 struct BundleProblem {
   std::vector<BundlePose> poses;
   std::vector<Eigen::Vector3d> points;
   std::vector<BundleObservation> observations;
+  std::vector<BundlePlanePair> plane_pairs;  // only between poses that have observations
 };
 
 struct BundleAdjustmentOptions {

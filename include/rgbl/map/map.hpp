@@ -46,6 +46,9 @@ struct Keyframe {
   std::vector<LandmarkId> landmarks;  // per keypoint; invalid = none
   std::map<KeyframeId, int> covisibility;  // other keyframe -> number of shared landmarks
   KeyframeId parent;                        // spanning tree; invalid for the root
+  // The road under the camera from its LiDAR scan: (n, d) of the plane n . x = d in the camera frame
+  // (n pointing down, d the camera's height); none without a scan or a road in it.
+  std::optional<Eigen::Vector4d> road;
 
   Eigen::Vector3d center() const { return T_cam_world.inverse().translation(); }
   int landmark_count() const;

@@ -48,6 +48,16 @@ std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const T
 // hundred times more points per square metre than a facade across the street).
 ScanSample scan_evidence(const ScanSample& sample, const TrackerOptions& options);
 
+// The road in a frame's scan sample (camera frame): the plane n . x = d of ground_points' RANSAC
+// (n pointing down, as the camera's y; d the camera's height above it), refitted by least squares to
+// its returns. nullopt without one.
+struct RoadPlane {
+  Eigen::Vector3d n = Eigen::Vector3d::UnitY();
+  double d = 0.0;
+  int points = 0;  // the returns it was fitted to
+};
+std::optional<RoadPlane> road_plane(const ScanSample& sample, const TrackerOptions& options);
+
 // Per keypoint of `frame`: with depth and on the dominant ground plane (options.ground_*, the plane
 // estimate_frame_motion ranks a consensus by). Empty when no such plane holds ground_min_points.
 std::vector<bool> ground_keypoints(const PinholeCamera& camera, const Frame& frame, const TrackerOptions& options);
