@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -104,4 +105,19 @@ TEST_CASE("revisit culling options are checked, naming the field") {
   o = {};
   o.max_keyframes_per_place = 1;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.max_keyframes_per_place"));
+}
+
+TEST_CASE("road pair options are checked, naming the field; 0 turns the pairs off") {
+  rgbl::LocalMappingOptions o;
+  o.road_sigma_offset = -0.1;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.road_sigma_offset"));
+  o = {};
+  o.road_sigma_tilt_deg = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.road_sigma_tilt_deg"));
+  o = {};
+  o.road_max_distance = 0.0;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.road_max_distance"));
+  o = {};
+  o.road_sigma_offset = 0.0;
+  CHECK_NOTHROW(o.validate());
 }
