@@ -125,13 +125,14 @@ TEST_CASE("loop closer: two laps of the simulator's loop are closed where the pl
   const int closures = check_closures(lap, with, 90);
   fmt::print("two laps of a 100 m loop: {} closures, ATE {:.3f} m (without loop closing {:.3f} m)\n", closures, with.ate,
              without.ate);
-  // measured: 1 closure (frame 91 with frame 0; the map agrees with the loop afterwards), ATE 0.054 m
-  // against 1.438 m (0.063 m with the global bundle adjustment, off by default: docs/loop-closing.md)
+  // measured: 2 closures (frames 91 and 199 with frame 0; the map agrees with the loop afterwards), ATE
+  // 0.056 m against 0.398 m (0.058 m with the global bundle adjustment, off by default). Before the road
+  // tied local BA's keyframes (2026-11-28): 1 closure, 0.054 m against 1.438 m (docs/loop-closing.md).
   CHECK(closures >= 1);
   CHECK(with.loops.closures == closures);
   CHECK(with.loops.implausible == 0);  // a true loop asks for no more than odometry drifts
   CHECK(with.ate < 0.08);
-  CHECK(with.ate < 0.1 * without.ate);
+  CHECK(with.ate < 0.25 * without.ate);
 }
 
 TEST_CASE("loop closer: two laps closed when the second is driven a lane to the left") {

@@ -107,7 +107,7 @@ TEST_CASE("revisit culling options are checked, naming the field") {
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.max_keyframes_per_place"));
 }
 
-TEST_CASE("road pair options are checked, naming the field; 0 turns the pairs off") {
+TEST_CASE("road pair options are checked, naming the field, and 0 turns the pairs off") {
   rgbl::LocalMappingOptions o;
   o.road_sigma_offset = -0.1;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.road_sigma_offset"));
