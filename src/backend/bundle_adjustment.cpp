@@ -62,7 +62,7 @@ struct PlanePairCost {
   Eigen::Vector3d b1, b2;  // across b's normal
   double inv_tilt, inv_offset;
 
-  PlanePairCost(const BundlePlanePair& pair) : a(pair.plane_a), b(pair.plane_b) {
+  explicit PlanePairCost(const BundlePlanePair& pair) : a(pair.plane_a), b(pair.plane_b) {
     const Eigen::Vector3d m = b.head<3>().normalized();
     const Eigen::Vector3d axis = std::abs(m.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitZ();
     b1 = (axis - axis.dot(m) * m).normalized();

@@ -95,17 +95,38 @@ std::vector<bool> ground_points(std::span<const Eigen::Vector3d> points, const T
   return plane ? on_ground(points, below, *plane, options) : std::vector<bool>{};
 }
 
-ScanSample scan_evidence(const ScanSample& sample, const TrackerOptions& options) {
-  std::vector<Eigen::Vector3d> points(sample.points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) points[i] = sample.points[i].cast<double>();
-  // The plane is fitted on at most 2000 of the returns below the camera (a scan holds ten times more
-  // than the road needs), and every one is then judged against it.
-  const std::vector<int> below = below_camera(points, options);
+namespace {
+
+// A scan sample's ground: its returns as doubles, those below the camera, and the plane with the
+// returns on it (`ground` empty without a plane). The plane is fitted on at most 2000 of the returns
+// below the camera (a scan holds ten times more than the road needs), and every one is then judged
+// against it.
+struct ScanGround {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> below;
+  std::optional<GroundPlane> plane;
+  std::vector<bool> ground;
+};
+
+ScanGround scan_ground(const ScanSample& sample, const TrackerOptions& options) {
+  ScanGround g;
+  g.points.resize(sample.points.size());
+  for (std::size_t i = 0; i < g.points.size(); ++i) g.points[i] = sample.points[i].cast<double>();
+  g.below = below_camera(g.points, options);
   std::vector<int> fit_on;
-  const std::size_t stride = below.size() / 2000 + 1;
-  for (std::size_t k = 0; k < below.size(); k += stride) fit_on.push_back(below[k]);
-  const std::optional<GroundPlane> plane = fit_ground(points, fit_on, options);
-  const std::vector<bool> ground = plane ? on_ground(points, below, *plane, options) : std::vector<bool>{};
+  const std::size_t stride = g.below.size() / 2000 + 1;
+  for (std::size_t k = 0; k < g.below.size(); k += stride) fit_on.push_back(g.below[k]);
+  g.plane = fit_ground(g.points, fit_on, options);
+  if (g.plane) g.ground = on_ground(g.points, g.below, *g.plane, options);
+  return g;
+}
+
+}  // namespace
+
+ScanSample scan_evidence(const ScanSample& sample, const TrackerOptions& options) {
+  const ScanGround g = scan_ground(sample, options);
+  const std::vector<Eigen::Vector3d>& points = g.points;
+  const std::vector<bool>& ground = g.ground;
   ScanSample evidence;
   VoxelIndex taken;
   taken.reserve(sample.points.size());
@@ -118,29 +139,22 @@ ScanSample scan_evidence(const ScanSample& sample, const TrackerOptions& options
 }
 
 std::optional<RoadPlane> road_plane(const ScanSample& sample, const TrackerOptions& options) {
-  std::vector<Eigen::Vector3d> points(sample.points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) points[i] = sample.points[i].cast<double>();
-  const std::vector<int> below = below_camera(points, options);
-  std::vector<int> fit_on;  // as scan_evidence: at most 2000 candidates for the RANSAC
-  const std::size_t stride = below.size() / 2000 + 1;
-  for (std::size_t k = 0; k < below.size(); k += stride) fit_on.push_back(below[k]);
-  const std::optional<GroundPlane> plane = fit_ground(points, fit_on, options);
-  if (!plane) return std::nullopt;
+  const ScanGround g = scan_ground(sample, options);
+  if (!g.plane) return std::nullopt;
   // least squares over every return on it: the plane through their centroid across their least spread
-  const std::vector<bool> ground = on_ground(points, below, *plane, options);
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   int count = 0;
-  for (const int i : below) {
-    if (!ground[static_cast<std::size_t>(i)]) continue;
-    mean += points[static_cast<std::size_t>(i)];
+  for (const int i : g.below) {
+    if (!g.ground[static_cast<std::size_t>(i)]) continue;
+    mean += g.points[static_cast<std::size_t>(i)];
     ++count;
   }
   if (count < options.ground_min_points) return std::nullopt;
   mean /= count;
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const int i : below) {
-    if (!ground[static_cast<std::size_t>(i)]) continue;
-    const Eigen::Vector3d q = points[static_cast<std::size_t>(i)] - mean;
+  for (const int i : g.below) {
+    if (!g.ground[static_cast<std::size_t>(i)]) continue;
+    const Eigen::Vector3d q = g.points[static_cast<std::size_t>(i)] - mean;
     scatter += q * q.transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);

@@ -128,8 +128,8 @@ struct TrackerOptions {
   // scan under one start only vote for it, and a start wins when the votes differ beyond chance over
   // objects, not returns (ScanVote::object_preference), and it holds on the local map. Images can
   // agree with a wrong pose (a car ahead at the ego speed, road paint repeating at the step length,
-  // motion blur that looks alike at zero motion); the static world's shape does not. Else, and without scans, the road re-finds and
-  // then the inliers decide, as before.
+  // motion blur that looks alike at zero motion); the static world's shape does not. Else, and
+  // without scans, the road re-finds and then the inliers decide, as before.
   bool scan_arbitration = true;
   ScanSampleOptions scan_sample;          // what a frame keeps of its scan (Frame::scan)
   // ...and where a frame is started against the reference keyframe (no trusted velocity, or the motion
