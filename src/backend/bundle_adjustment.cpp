@@ -90,6 +90,46 @@ struct PlanePairCost {
   }
 };
 
+// BundlePosePair's residual: E = inv(T_b_a measured) * T_b * inv(T_a), [t_E / sigma_t; log(R_E) / sigma_r].
+struct PosePairCost {
+  Eigen::Matrix3d R_m;  // rotation of inv(T_b_a)
+  Eigen::Vector3d t_m;  // translation of inv(T_b_a)
+  Eigen::Matrix<double, 6, 1> inv_sigma;
+
+  explicit PosePairCost(const BundlePosePair& pair)
+      : R_m(pair.T_b_a.linear().transpose()), t_m(-(pair.T_b_a.linear().transpose() * pair.T_b_a.translation())) {
+    const double t = 1.0 / pair.sigma_translation, r = 1.0 / pair.sigma_rotation;
+    inv_sigma << t, t, t, r, r, r;
+    if (pair.level_only) inv_sigma(1) = inv_sigma(3) = inv_sigma(5) = 0.0;
+  }
+
+  template <typename T>
+  bool operator()(const T* wa, const T* ta, const T* wb, const T* tb, T* residual) const {
+    T Ra[9], Rb[9];  // column-major
+    ceres::AngleAxisToRotationMatrix(wa, ceres::ColumnMajorAdapter3x3(Ra));
+    ceres::AngleAxisToRotationMatrix(wb, ceres::ColumnMajorAdapter3x3(Rb));
+    using M3 = Eigen::Matrix<T, 3, 3>;
+    using V3 = Eigen::Matrix<T, 3, 1>;
+    const Eigen::Map<const M3> R_a(Ra), R_b(Rb);
+    const Eigen::Map<const V3> t_a(ta), t_b(tb);
+    // T_b * inv(T_a): R_b R_a^T, t_b - R_b R_a^T t_a
+    const M3 R_ba = R_b * R_a.transpose();
+    const V3 t_ba = t_b - R_ba * t_a;
+    const M3 R_e = R_m.cast<T>() * R_ba;
+    const V3 t_e = R_m.cast<T>() * t_ba + t_m.cast<T>();
+    T R_e_data[9];
+    Eigen::Map<M3> R_e_map(R_e_data);
+    R_e_map = R_e;
+    T w[3];
+    ceres::RotationMatrixToAngleAxis(ceres::ColumnMajorAdapter3x3(static_cast<const T*>(R_e_data)), w);
+    for (int i = 0; i < 3; ++i) {
+      residual[i] = t_e[i] * inv_sigma(i);
+      residual[3 + i] = w[i] * inv_sigma(3 + i);
+    }
+    return true;
+  }
+};
+
 class AbortCallback : public ceres::IterationCallback {
  public:
   explicit AbortCallback(const std::atomic<bool>* abort) : abort_(abort) {}
@@ -183,6 +223,15 @@ BundleAdjustmentResult bundle_adjust(const PinholeCamera& camera, BundleProblem&
     if (ia >= poses.size() || ib >= poses.size() || ia == ib || !pose_used[ia] || !pose_used[ib]) continue;
     ceres_problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlanePairCost, 3, 3, 3, 3, 3>(new PlanePairCost(pair)),
                                    new ceres::HuberLoss(delta3), poses[ia].data(), poses[ia].data() + 3,
+                                   poses[ib].data(), poses[ib].data() + 3);
+  }
+
+  const double delta6 = std::sqrt(12.592);  // 95 % of chi2 with 6 dof
+  for (const BundlePosePair& pair : problem.pose_pairs) {
+    const auto ia = static_cast<std::size_t>(pair.pose_a), ib = static_cast<std::size_t>(pair.pose_b);
+    if (ia >= poses.size() || ib >= poses.size() || ia == ib || !pose_used[ia] || !pose_used[ib]) continue;
+    ceres_problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PosePairCost, 6, 3, 3, 3, 3>(new PosePairCost(pair)),
+                                   new ceres::HuberLoss(delta6), poses[ia].data(), poses[ia].data() + 3,
                                    poses[ib].data(), poses[ib].data() + 3);
   }
 

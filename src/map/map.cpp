@@ -115,6 +115,11 @@ void Map::erase_keyframe(KeyframeId keyframe_id) {
   // A parent is always older than its child, so the tree never closes a cycle.
   KeyframeId new_parent = k->parent;
   for (auto& slot : keyframes_) {
+    // the motion measured into this keyframe is carried on to the one measured from it
+    if (slot && slot->previous == keyframe_id) {
+      slot->previous = k->previous;
+      slot->T_cam_previous = slot->T_cam_previous * k->T_cam_previous;
+    }
     if (!slot || slot->parent != keyframe_id) continue;
     KeyframeId best = new_parent;
     int best_weight = -1;

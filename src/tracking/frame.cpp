@@ -89,6 +89,10 @@ void LocalMappingOptions::validate() const {
   require(std::isfinite(road_sigma_tilt_deg) && road_sigma_tilt_deg >= 0.0, "local_mapping.road_sigma_tilt_deg",
           ">= 0 deg (0 = off)");
   require(std::isfinite(road_max_distance) && road_max_distance > 0.0, "local_mapping.road_max_distance", "> 0 m");
+  require(std::isfinite(odometry_sigma_translation) && odometry_sigma_translation >= 0.0,
+          "local_mapping.odometry_sigma_translation", ">= 0 m (0 = off)");
+  require(std::isfinite(odometry_sigma_rotation) && odometry_sigma_rotation >= 0.0,
+          "local_mapping.odometry_sigma_rotation", ">= 0 rad (0 = off)");
   require(min_found_ratio >= 0.0 && min_found_ratio <= 1.0, "local_mapping.min_found_ratio", "in [0, 1]");
   require(redundant_ratio > 0.0 && redundant_ratio <= 1.0, "local_mapping.redundant_ratio", "in (0, 1]");
   require(place_distance_ratio > 0.0 && place_distance_ratio < 1.0, "local_mapping.place_distance_ratio",

@@ -915,7 +915,12 @@ bool Tracker::need_keyframe(const Frame& frame, int inliers, bool mapping_idle) 
 
 KeyframeId Tracker::make_keyframe(const Frame& frame) {
   std::unique_lock lock(map_.mutex());
-  const KeyframeId id = map_.add_keyframe(keyframe_from(frame, options_));
+  Keyframe made = keyframe_from(frame, options_);
+  if (const Keyframe* previous = map_.keyframe(reference_)) {
+    made.previous = reference_;
+    made.T_cam_previous = frame.T_cam_world * previous->T_cam_world.inverse();
+  }
+  const KeyframeId id = map_.add_keyframe(std::move(made));
   for (std::size_t i = 0; i < frame.size(); ++i) {
     if (frame.landmarks[i].valid() && !frame.outlier[i]) map_.add_observation(frame.landmarks[i], id, static_cast<int>(i));
   }

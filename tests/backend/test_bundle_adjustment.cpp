@@ -212,3 +212,104 @@ TEST_CASE("bundle adjustment: a road seen by two poses ties the second's height 
   rgbl::bundle_adjust(camera, problem, options);
   CHECK((problem.poses[1].T_cam_world.inverse().translation() - before.inverse().translation()).norm() < 1e-6);
 }
+
+TEST_CASE("bundle adjustment: the motion measured between two poses places the second where only it ties b") {
+  // Pose a (fixed) and pose b 10 m further; b's points are seen by b alone, so nothing but the pose pair
+  // ties b to a. b starts 0.3 m to the side, 0.2 m short and turned by 1 deg: the pair (the true motion)
+  // brings all six back; without it nothing moves b.
+  const auto camera = rgbl::test::kitti_camera();
+  const Eigen::Isometry3d T_a = rgbl::make_isometry(rgbl::so3_exp({0.01, -0.2, 0.0}), Eigen::Vector3d(1.0, 0.0, 2.0));
+  const Eigen::Isometry3d T_b_a = rgbl::make_isometry(rgbl::so3_exp({0.0, 0.05, 0.0}), Eigen::Vector3d(0.1, 0.0, -10.0));
+  const Eigen::Isometry3d T_b_true = T_b_a * T_a;
+  const Eigen::Isometry3d error =
+      rgbl::make_isometry(rgbl::so3_exp({0.0, 0.0175, 0.0}), Eigen::Vector3d(0.3, 0.0, 0.2));
+  rgbl::BundleProblem problem;
+  problem.poses.push_back({T_a, true});
+  problem.poses.push_back({error * T_b_true, false});
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int pose = 0; pose < 2; ++pose) {
+    const Eigen::Isometry3d& T = problem.poses[static_cast<std::size_t>(pose)].T_cam_world;
+    for (int k = 0; k < 40; ++k) {
+      const Eigen::Vector3d p_cam(6.0 * u(rng), 1.5 * u(rng), 12.0 + 8.0 * u(rng));
+      rgbl::BundleObservation o;
+      o.pose = pose;
+      o.point = static_cast<int>(problem.points.size());
+      o.pixel = camera.project_unchecked(p_cam);
+      o.depth = p_cam.z();
+      o.depth_sigma = 0.05;
+      problem.points.push_back(T.inverse() * p_cam);
+      problem.observations.push_back(o);
+    }
+  }
+  rgbl::BundlePosePair pair;
+  pair.pose_a = 0;
+  pair.pose_b = 1;
+  pair.T_b_a = T_b_a;
+  pair.sigma_translation = 0.05;
+  pair.sigma_rotation = 0.005;
+  problem.pose_pairs.push_back(pair);
+  rgbl::BundleAdjustmentOptions options;
+  options.iterations = 50;
+  const std::vector<Eigen::Vector3d> points = problem.points;
+  rgbl::bundle_adjust(camera, problem, options);
+  const Eigen::Isometry3d E = problem.poses[1].T_cam_world * T_b_true.inverse();
+  CHECK(E.translation().norm() < 1e-5);
+  CHECK(rgbl::so3_log(E.linear()).norm() < 1e-6);
+  CHECK(problem.poses[0].T_cam_world.isApprox(T_a));  // a is fixed
+  // without the pair nothing moves b: its own points agree with it
+  problem.pose_pairs.clear();
+  problem.poses[1].T_cam_world = error * T_b_true;
+  problem.points = points;
+  const Eigen::Isometry3d before = problem.poses[1].T_cam_world;
+  rgbl::bundle_adjust(camera, problem, options);
+  CHECK((problem.poses[1].T_cam_world.inverse().translation() - before.inverse().translation()).norm() < 1e-6);
+}
+
+TEST_CASE("bundle adjustment: a level-only motion pair corrects along, across and the heading, not height or tilt") {
+  // As above, with b's error written as E = inv(T_b_a) * T_b * inv(T_a), the pair's own residual frame.
+  const auto camera = rgbl::test::kitti_camera();
+  const Eigen::Isometry3d T_a = Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d T_b_a = rgbl::make_isometry(rgbl::so3_exp({0.0, 0.05, 0.0}), Eigen::Vector3d(0.1, 0.0, -10.0));
+  const auto solve = [&](const Eigen::Isometry3d& E_initial) {
+    rgbl::BundleProblem problem;
+    problem.poses.push_back({T_a, true});
+    problem.poses.push_back({T_b_a * E_initial * T_a, false});
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (int pose = 0; pose < 2; ++pose) {
+      const Eigen::Isometry3d& T = problem.poses[static_cast<std::size_t>(pose)].T_cam_world;
+      for (int k = 0; k < 40; ++k) {
+        const Eigen::Vector3d p_cam(6.0 * u(rng), 1.5 * u(rng), 12.0 + 8.0 * u(rng));
+        rgbl::BundleObservation o;
+        o.pose = pose;
+        o.point = static_cast<int>(problem.points.size());
+        o.pixel = camera.project_unchecked(p_cam);
+        o.depth = p_cam.z();
+        o.depth_sigma = 0.05;
+        problem.points.push_back(T.inverse() * p_cam);
+        problem.observations.push_back(o);
+      }
+    }
+    rgbl::BundlePosePair pair;
+    pair.pose_a = 0;
+    pair.pose_b = 1;
+    pair.T_b_a = T_b_a;
+    pair.level_only = true;
+    problem.pose_pairs.push_back(pair);
+    rgbl::BundleAdjustmentOptions options;
+    options.iterations = 50;
+    rgbl::bundle_adjust(camera, problem, options);
+    return Eigen::Isometry3d(T_b_a.inverse() * problem.poses[1].T_cam_world * T_a.inverse());
+  };
+  // height, pitch and roll only: the pair does not see them, b stays
+  const Eigen::Isometry3d E_level = rgbl::make_isometry(rgbl::so3_exp({0.02, 0.0, 0.015}), Eigen::Vector3d(0.0, -0.4, 0.0));
+  CHECK(solve(E_level).isApprox(E_level, 1e-7));
+  // all six: along, across and the heading go to zero, height stays
+  const Eigen::Isometry3d E_all = rgbl::make_isometry(rgbl::so3_exp({0.02, 0.0175, 0.015}), Eigen::Vector3d(0.3, -0.4, 0.2));
+  const Eigen::Isometry3d E = solve(E_all);
+  CHECK(std::abs(E.translation().x()) < 1e-6);
+  CHECK(std::abs(E.translation().z()) < 1e-6);
+  CHECK(std::abs(rgbl::so3_log(E.linear()).y()) < 1e-7);
+  CHECK(E.translation().y() == Approx(-0.4).margin(0.01));
+}

@@ -121,3 +121,15 @@ TEST_CASE("road pair options are checked, naming the field, and 0 turns the pair
   o.road_sigma_offset = 0.0;
   CHECK_NOTHROW(o.validate());
 }
+
+TEST_CASE("keyframe motion pair options are checked, naming the field, and 0 turns the pairs off") {
+  rgbl::LocalMappingOptions o;
+  o.odometry_sigma_translation = -0.05;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.odometry_sigma_translation"));
+  o = {};
+  o.odometry_sigma_rotation = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.odometry_sigma_rotation"));
+  o = {};
+  o.odometry_sigma_translation = 0.0;
+  CHECK_NOTHROW(o.validate());
+}

@@ -190,3 +190,44 @@ TEST_CASE("a System without a depth source of its own tracks built frames, the s
     CHECK(T_world_cam0.matrix() == own.estimate[i].matrix());
   }
 }
+
+TEST_CASE("seq 04: each keyframe keeps the motion tracked from the one before, and local BA keeps to it") {
+  const auto dir = rgbl::test::kitti_seq04();
+  if (!dir) return;
+  const auto sequence = rgbl::open_kitti_odometry(*dir);
+  const rgbl::CameraCalibration calibration = sequence->calibration().camera(0);
+  rgbl::DepthSourceContext context;
+  context.calibration = calibration;
+  const rgbl::SystemOptions options;
+  auto orb = std::make_shared<rgbl::OrbExtractor>();
+  rgbl::FrameBuilder builder(calibration, options.depth_noise, rgbl::make_lidar_source({}, context),
+                             [orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
+                               orb->extract(g, k, d);
+                             });
+  rgbl::System system(options, calibration);
+  for (std::size_t i = 0; i < 30; ++i) {
+    const rgbl::FrameInput input = sequence->load(i);  // the frame views its images
+    rgbl::SensorFrame frame = rgbl::test::sensor_frame(input, 0);
+    frame.index = i;
+    REQUIRE(rgbl::has_pose(system.track(frame, builder.build(frame)).state));
+  }
+  const rgbl::Map& map = system.map();
+  int paired = 0;
+  for (const rgbl::KeyframeId id : map.keyframe_ids()) {
+    const rgbl::Keyframe& kf = *map.keyframe(id);
+    if (!kf.previous.valid()) {
+      CHECK(id.value == 0);  // only a map's first keyframe has none
+      continue;
+    }
+    CHECK(kf.previous < id);
+    const rgbl::Keyframe* previous = map.keyframe(kf.previous);
+    REQUIRE(previous != nullptr);  // erasing a keyframe hands its successor the one before it
+    // the map's relative pose against the tracked one (sigmas 0.1 m, 0.005 rad; the road decides
+    // height and tilt)
+    const Eigen::Isometry3d E = kf.T_cam_previous.inverse() * kf.T_cam_world * previous->T_cam_world.inverse();
+    CHECK(E.translation().norm() < 0.05);  // 0.022 m at most, measured
+    CHECK(rgbl::so3_log(E.linear()).norm() < 0.005);  // 0.0012 rad at most, measured
+    ++paired;
+  }
+  CHECK(paired >= 5);
+}

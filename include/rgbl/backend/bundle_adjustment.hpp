@@ -37,11 +37,24 @@ struct BundlePlanePair {
   Eigen::Vector4d plane_a = Eigen::Vector4d::UnitY(), plane_b = Eigen::Vector4d::UnitY();
   double sigma_tilt = 0.01, sigma_offset = 0.05;
 };
+// The motion tracking measured between two poses: T_b_a = T_cam_b_world * inv(T_cam_a_world). Six
+// residuals of E = inv(T_b_a) * T_b * inv(T_a) in b's frame: its translation (m, by sigma_translation)
+// and rotation angle-vector (rad, by sigma_rotation); Huber at 3.55 (95 % of chi2, 6 dof). level_only
+// keeps the three a road pair does not see: translation along b's x and z axes and rotation about
+// its y axis (down).
+struct BundlePosePair {
+  int pose_a = 0, pose_b = 0;
+  Eigen::Isometry3d T_b_a = Eigen::Isometry3d::Identity();
+  double sigma_translation = 0.05, sigma_rotation = 0.005;
+  bool level_only = false;
+};
+
 struct BundleProblem {
   std::vector<BundlePose> poses;
   std::vector<Eigen::Vector3d> points;
   std::vector<BundleObservation> observations;
   std::vector<BundlePlanePair> plane_pairs;  // only between poses that have observations
+  std::vector<BundlePosePair> pose_pairs;    // only between poses that have observations
 };
 
 struct BundleAdjustmentOptions {

@@ -49,6 +49,11 @@ struct Keyframe {
   // The road under the camera from its LiDAR scan: (n, d) of the plane n . x = d in the camera frame
   // (n pointing down, d the camera's height); none without a scan or a road in it.
   std::optional<Eigen::Vector4d> road;
+  // The motion tracking measured from the keyframe before it (its reference when it was made):
+  // T_cam_previous = T_cam_world * inv(T_previous_world) at insertion; local BA keeps to it. None for a
+  // map's first. Erasing the previous one hands over its own previous, the motions composed.
+  KeyframeId previous;
+  Eigen::Isometry3d T_cam_previous = Eigen::Isometry3d::Identity();
 
   Eigen::Vector3d center() const { return T_cam_world.inverse().translation(); }
   int landmark_count() const;
