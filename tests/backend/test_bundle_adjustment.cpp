@@ -14,6 +14,27 @@ Eigen::Isometry3d pose_along_road(double z) {
   return rgbl::se3_exp(xi);
 }
 
+// 40 points in front of each pose, seen by that pose alone (pixel and depth exact at its current
+// pose): every pose is in the problem, and nothing but the pairs ties one to another.
+void add_own_points(rgbl::BundleProblem& problem, const rgbl::PinholeCamera& camera, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (std::size_t pose = 0; pose < problem.poses.size(); ++pose) {
+    const Eigen::Isometry3d T = problem.poses[pose].T_cam_world;
+    for (int k = 0; k < 40; ++k) {
+      const Eigen::Vector3d p_cam(6.0 * u(rng), 1.5 * u(rng), 12.0 + 8.0 * u(rng));
+      rgbl::BundleObservation o;
+      o.pose = static_cast<int>(pose);
+      o.point = static_cast<int>(problem.points.size());
+      o.pixel = camera.project_unchecked(p_cam);
+      o.depth = p_cam.z();
+      o.depth_sigma = 0.05;
+      problem.points.push_back(T.inverse() * p_cam);
+      problem.observations.push_back(o);
+    }
+  }
+}
+
 }  // namespace
 
 TEST_CASE("bundle residual Jacobians match numeric differentiation") {
@@ -168,23 +189,7 @@ TEST_CASE("bundle adjustment: a road seen by two poses ties the second's height 
   problem.poses.push_back({T_a, true});
   const Eigen::Isometry3d error = rgbl::make_isometry(rgbl::so3_exp({0.026, 0.0, 0.017}), Eigen::Vector3d(0.0, -0.4, 0.0));
   problem.poses.push_back({error * T_b_true, false});
-  // every pose needs observations to be in the problem: a's points seen by a, b's by b
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (int pose = 0; pose < 2; ++pose) {
-    const Eigen::Isometry3d& T = pose == 0 ? T_a : problem.poses[1].T_cam_world;
-    for (int k = 0; k < 40; ++k) {
-      const Eigen::Vector3d p_cam(6.0 * u(rng), 1.5 * u(rng), 12.0 + 8.0 * u(rng));
-      rgbl::BundleObservation o;
-      o.pose = pose;
-      o.point = static_cast<int>(problem.points.size());
-      o.pixel = camera.project_unchecked(p_cam);
-      o.depth = p_cam.z();
-      o.depth_sigma = 0.05;
-      problem.points.push_back(T.inverse() * p_cam);
-      problem.observations.push_back(o);
-    }
-  }
+  add_own_points(problem, camera, 5);
   rgbl::BundlePlanePair pair;
   pair.pose_a = 0;
   pair.pose_b = 1;
@@ -226,22 +231,7 @@ TEST_CASE("bundle adjustment: the motion measured between two poses places the s
   rgbl::BundleProblem problem;
   problem.poses.push_back({T_a, true});
   problem.poses.push_back({error * T_b_true, false});
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (int pose = 0; pose < 2; ++pose) {
-    const Eigen::Isometry3d& T = problem.poses[static_cast<std::size_t>(pose)].T_cam_world;
-    for (int k = 0; k < 40; ++k) {
-      const Eigen::Vector3d p_cam(6.0 * u(rng), 1.5 * u(rng), 12.0 + 8.0 * u(rng));
-      rgbl::BundleObservation o;
-      o.pose = pose;
-      o.point = static_cast<int>(problem.points.size());
-      o.pixel = camera.project_unchecked(p_cam);
-      o.depth = p_cam.z();
-      o.depth_sigma = 0.05;
-      problem.points.push_back(T.inverse() * p_cam);
-      problem.observations.push_back(o);
-    }
-  }
+  add_own_points(problem, camera, 7);
   rgbl::BundlePosePair pair;
   pair.pose_a = 0;
   pair.pose_b = 1;
@@ -275,22 +265,7 @@ TEST_CASE("bundle adjustment: a level-only motion pair corrects along, across an
     rgbl::BundleProblem problem;
     problem.poses.push_back({T_a, true});
     problem.poses.push_back({T_b_a * E_initial * T_a, false});
-    std::mt19937 rng(11);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    for (int pose = 0; pose < 2; ++pose) {
-      const Eigen::Isometry3d& T = problem.poses[static_cast<std::size_t>(pose)].T_cam_world;
-      for (int k = 0; k < 40; ++k) {
-        const Eigen::Vector3d p_cam(6.0 * u(rng), 1.5 * u(rng), 12.0 + 8.0 * u(rng));
-        rgbl::BundleObservation o;
-        o.pose = pose;
-        o.point = static_cast<int>(problem.points.size());
-        o.pixel = camera.project_unchecked(p_cam);
-        o.depth = p_cam.z();
-        o.depth_sigma = 0.05;
-        problem.points.push_back(T.inverse() * p_cam);
-        problem.observations.push_back(o);
-      }
-    }
+    add_own_points(problem, camera, 11);
     rgbl::BundlePosePair pair;
     pair.pose_a = 0;
     pair.pose_b = 1;

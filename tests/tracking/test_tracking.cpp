@@ -37,6 +37,17 @@ rgbl::CameraCalibration small_camera() {
   return c;
 }
 
+// Frames built outside the System, as a caller with its own threads would: LiDAR depth, ORB features.
+rgbl::FrameBuilder lidar_frame_builder(const rgbl::CameraCalibration& calibration, const rgbl::SystemOptions& options) {
+  rgbl::DepthSourceContext context;
+  context.calibration = calibration;
+  auto orb = std::make_shared<rgbl::OrbExtractor>();
+  return rgbl::FrameBuilder(calibration, options.depth_noise, rgbl::make_lidar_source({}, context),
+                            [orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
+                              orb->extract(g, k, d);
+                            });
+}
+
 }  // namespace
 
 TEST_CASE("keypoint grid returns exactly the keypoints inside the window and level range") {
@@ -165,14 +176,8 @@ TEST_CASE("a System without a depth source of its own tracks built frames, the s
   if (!dir) return;
   const auto sequence = rgbl::open_kitti_odometry(*dir);
   const rgbl::CameraCalibration calibration = sequence->calibration().camera(0);
-  rgbl::DepthSourceContext context;
-  context.calibration = calibration;
   const rgbl::SystemOptions options;
-  auto orb = std::make_shared<rgbl::OrbExtractor>();
-  rgbl::FrameBuilder builder(calibration, options.depth_noise, rgbl::make_lidar_source({}, context),
-                             [orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
-                               orb->extract(g, k, d);
-                             });
+  rgbl::FrameBuilder builder = lidar_frame_builder(calibration, options);
   rgbl::System system(options, calibration);
   constexpr std::size_t kFrames = 12;
   for (std::size_t i = 0; i < kFrames; ++i) {
@@ -196,14 +201,8 @@ TEST_CASE("seq 04: each keyframe keeps the motion tracked from the one before, a
   if (!dir) return;
   const auto sequence = rgbl::open_kitti_odometry(*dir);
   const rgbl::CameraCalibration calibration = sequence->calibration().camera(0);
-  rgbl::DepthSourceContext context;
-  context.calibration = calibration;
   const rgbl::SystemOptions options;
-  auto orb = std::make_shared<rgbl::OrbExtractor>();
-  rgbl::FrameBuilder builder(calibration, options.depth_noise, rgbl::make_lidar_source({}, context),
-                             [orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
-                               orb->extract(g, k, d);
-                             });
+  rgbl::FrameBuilder builder = lidar_frame_builder(calibration, options);
   rgbl::System system(options, calibration);
   for (std::size_t i = 0; i < 30; ++i) {
     const rgbl::FrameInput input = sequence->load(i);  // the frame views its images
