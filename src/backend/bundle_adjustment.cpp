@@ -105,23 +105,18 @@ struct PosePairCost {
 
   template <typename T>
   bool operator()(const T* wa, const T* ta, const T* wb, const T* tb, T* residual) const {
-    T Ra[9], Rb[9];  // column-major
-    ceres::AngleAxisToRotationMatrix(wa, ceres::ColumnMajorAdapter3x3(Ra));
-    ceres::AngleAxisToRotationMatrix(wb, ceres::ColumnMajorAdapter3x3(Rb));
-    using M3 = Eigen::Matrix<T, 3, 3>;
+    using M3 = Eigen::Matrix<T, 3, 3>;  // column-major, as ColumnMajorAdapter3x3 expects
     using V3 = Eigen::Matrix<T, 3, 1>;
-    const Eigen::Map<const M3> R_a(Ra), R_b(Rb);
-    const Eigen::Map<const V3> t_a(ta), t_b(tb);
-    // T_b * inv(T_a): R_b R_a^T, t_b - R_b R_a^T t_a
+    M3 R_a, R_b;
+    ceres::AngleAxisToRotationMatrix(wa, ceres::ColumnMajorAdapter3x3(R_a.data()));
+    ceres::AngleAxisToRotationMatrix(wb, ceres::ColumnMajorAdapter3x3(R_b.data()));
+    // T_b * inv(T_a): R_b R_a^T, t_b - R_b R_a^T t_a; then inv(T_b_a) * that
     const M3 R_ba = R_b * R_a.transpose();
-    const V3 t_ba = t_b - R_ba * t_a;
+    const V3 t_ba = Eigen::Map<const V3>(tb) - R_ba * Eigen::Map<const V3>(ta);
     const M3 R_e = R_m.cast<T>() * R_ba;
     const V3 t_e = R_m.cast<T>() * t_ba + t_m.cast<T>();
-    T R_e_data[9];
-    Eigen::Map<M3> R_e_map(R_e_data);
-    R_e_map = R_e;
     T w[3];
-    ceres::RotationMatrixToAngleAxis(ceres::ColumnMajorAdapter3x3(static_cast<const T*>(R_e_data)), w);
+    ceres::RotationMatrixToAngleAxis(ceres::ColumnMajorAdapter3x3(R_e.data()), w);
     for (int i = 0; i < 3; ++i) {
       residual[i] = t_e[i] * inv_sigma(i);
       residual[3 + i] = w[i] * inv_sigma(3 + i);
@@ -218,9 +213,14 @@ BundleAdjustmentResult bundle_adjust(const PinholeCamera& camera, BundleProblem&
     }
   }
 
+  // a pair between two distinct poses of the problem that have observations
+  const auto usable = [&](int a, int b) {
+    const auto ia = static_cast<std::size_t>(a), ib = static_cast<std::size_t>(b);
+    return a >= 0 && b >= 0 && ia < poses.size() && ib < poses.size() && ia != ib && pose_used[ia] && pose_used[ib];
+  };
   for (const BundlePlanePair& pair : problem.plane_pairs) {
+    if (!usable(pair.pose_a, pair.pose_b)) continue;
     const auto ia = static_cast<std::size_t>(pair.pose_a), ib = static_cast<std::size_t>(pair.pose_b);
-    if (ia >= poses.size() || ib >= poses.size() || ia == ib || !pose_used[ia] || !pose_used[ib]) continue;
     ceres_problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlanePairCost, 3, 3, 3, 3, 3>(new PlanePairCost(pair)),
                                    new ceres::HuberLoss(delta3), poses[ia].data(), poses[ia].data() + 3,
                                    poses[ib].data(), poses[ib].data() + 3);
@@ -228,8 +228,8 @@ BundleAdjustmentResult bundle_adjust(const PinholeCamera& camera, BundleProblem&
 
   const double delta6 = std::sqrt(12.592);  // 95 % of chi2 with 6 dof
   for (const BundlePosePair& pair : problem.pose_pairs) {
+    if (!usable(pair.pose_a, pair.pose_b)) continue;
     const auto ia = static_cast<std::size_t>(pair.pose_a), ib = static_cast<std::size_t>(pair.pose_b);
-    if (ia >= poses.size() || ib >= poses.size() || ia == ib || !pose_used[ia] || !pose_used[ib]) continue;
     ceres_problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PosePairCost, 6, 3, 3, 3, 3>(new PosePairCost(pair)),
                                    new ceres::HuberLoss(delta6), poses[ia].data(), poses[ia].data() + 3,
                                    poses[ib].data(), poses[ib].data() + 3);

@@ -177,10 +177,9 @@ struct LocalMappingOptions {
   // optimised keyframe to that one (BundlePosePair). Landmarks seen by fewer than 3 keyframes are
   // culled, and with them most of what tied a keyframe to the one before: on the simulator's 400 m loop
   // 18 points tied a window to its fixed keyframes, and local BA moved new keyframes 0.1-0.3 m sideways
-  // against a tracked step that was right within 0.01 m. Where both keyframes saw the road, the pair
-  // leaves height and tilt to the road pair. Sigmas per axis between two keyframes; 0.1 m chosen over
-  // 0.05 m on the whole suite and the loop table (docs/accuracy.md, "Keyframes keep the tracked
-  // motion"); 0 = off.
+  // against a step tracking had right. Where both keyframes saw the road, the pair leaves height and
+  // tilt to the road pair. Sigmas per axis between two keyframes; 0.1 m chosen over 0.05 m on the
+  // whole suite and the loop table (docs/accuracy.md, "Keyframes keep the tracked motion"); 0 = off.
   double odometry_sigma_translation = 0.1;   // m
   double odometry_sigma_rotation = 0.005;    // rad
   double min_found_ratio = 0.25;        // landmark culling
