@@ -7,9 +7,11 @@
 For each pair of consecutive frames, E = (T_gt_i^-1 T_gt_i+1)^-1 (T_est_i^-1 T_est_i+1); prints the mean
 (bias) and RMS (jitter) of E's rotation about x (pitch), y (yaw), z (roll) in degrees and of its
 translation in metres (x right, y down, z forward); then the five steps with the largest translation
-error, and the ATE by axis after a rigid (SE(3)) alignment, in the first frame's axes. Needs
-python3-numpy.
+error, and the ATE by axis after a rigid (SE(3)) alignment, in the first frame's axes. Given a run
+folder with timing.csv, also the same rotation error between consecutive keyframes (the frames made
+keyframes, at their written poses). Needs python3-numpy.
 """
+import csv
 import pathlib
 import sys
 
@@ -31,10 +33,24 @@ def rotation_vector(R):
     return angle / (2.0 * np.sin(angle)) * axis
 
 
+def step_errors(est, gt, pairs):
+    """Rotation (deg) and translation (m) error of the motion i -> j for each pair (i, j)."""
+    rot, trans = [], []
+    for i, j in pairs:
+        E = np.linalg.inv(np.linalg.inv(gt[i]) @ gt[j]) @ (np.linalg.inv(est[i]) @ est[j])
+        rot.append(np.degrees(rotation_vector(E[:3, :3])))
+        trans.append(E[:3, 3])
+    return np.array(rot), np.array(trans)
+
+
 def main():
+    keyframes = []
     if len(sys.argv) == 2:
         run = pathlib.Path(sys.argv[1])
         estimate, truth = run / "trajectory_kitti.txt", run / "ground_truth_kitti.txt"
+        if (run / "timing.csv").exists():
+            with open(run / "timing.csv", newline="") as f:
+                keyframes = [int(r["frame"]) for r in csv.DictReader(f) if r["keyframe"] == "1"]
     elif len(sys.argv) == 3:
         estimate, truth = sys.argv[1], sys.argv[2]
     else:
@@ -43,18 +59,16 @@ def main():
     n = min(len(est), len(gt))
     if n < 2:
         sys.exit("error: fewer than 2 poses to compare")
-    rot, trans = [], []
-    for i in range(n - 1):
-        step_est = np.linalg.inv(est[i]) @ est[i + 1]
-        step_gt = np.linalg.inv(gt[i]) @ gt[i + 1]
-        E = np.linalg.inv(step_gt) @ step_est
-        rot.append(np.degrees(rotation_vector(E[:3, :3])))
-        trans.append(E[:3, 3])
-    rot, trans = np.array(rot), np.array(trans)
+    rot, trans = step_errors(est, gt, [(i, i + 1) for i in range(n - 1)])
     print(f"{n} frames")
     print("rotation deg     pitch(x)  yaw(y)   roll(z)")
     print("  mean (bias)   " + "".join(f"{v:9.4f}" for v in rot.mean(axis=0)))
     print("  rms (jitter)  " + "".join(f"{v:9.4f}" for v in np.sqrt((rot ** 2).mean(axis=0))))
+    keyframes = [k for k in keyframes if k < n]
+    if len(keyframes) >= 2:
+        kf_rot, _ = step_errors(est, gt, list(zip(keyframes[:-1], keyframes[1:])))
+        print("  rms keyframes " + "".join(f"{v:9.4f}" for v in np.sqrt((kf_rot ** 2).mean(axis=0)))
+              + f"   (between {len(keyframes)} consecutive keyframes)")
     print("translation m    x        y(down)  z(fwd)")
     print("  mean (bias)   " + "".join(f"{v:9.4f}" for v in trans.mean(axis=0)))
     print("  rms (jitter)  " + "".join(f"{v:9.4f}" for v in np.sqrt((trans ** 2).mean(axis=0))))

@@ -39,6 +39,7 @@ void LoopClosingOptions::validate() const {
   require(fusion_neighbours >= 0, "loop_closing.fusion_neighbours", ">= 0 keyframes");
   fusion.validate();
   global_ba_options.validate();
+  global_ba_pairs.validate();
   require(global_ba_min_shared >= 0, "loop_closing.global_ba_min_shared", ">= 0 observations");
 }
 
@@ -222,6 +223,7 @@ void LoopCloser::adjust_map(Map& map, KeyframeId keyframe, LoopClosure& closure)
     bundle.problem.poses[i].fixed = true;
     held.emplace_back(kf->id, kf->T_cam_world * T_parent_world->inverse());
   }
+  add_keyframe_pairs(map, bundle, options_.global_ba_pairs);
   const BundleAdjustmentResult result = bundle_adjust(camera_, bundle.problem, options_.global_ba_options);
   closure.global_ba_keyframes = static_cast<int>(bundle.keyframes.size());
   closure.global_ba_landmarks = static_cast<int>(bundle.landmarks.size());

@@ -84,15 +84,7 @@ void TrackerOptions::validate() const {
 void LocalMappingOptions::validate() const {
   require(max_new_depth_points >= 0, "local_mapping.max_new_depth_points", ">= 0");
   require(max_local_ba_keyframes >= 1, "local_mapping.max_local_ba_keyframes", ">= 1");
-  require(std::isfinite(road_sigma_offset) && road_sigma_offset >= 0.0, "local_mapping.road_sigma_offset",
-          ">= 0 m (0 = off)");
-  require(std::isfinite(road_sigma_tilt_deg) && road_sigma_tilt_deg >= 0.0, "local_mapping.road_sigma_tilt_deg",
-          ">= 0 deg (0 = off)");
-  require(std::isfinite(road_max_distance) && road_max_distance > 0.0, "local_mapping.road_max_distance", "> 0 m");
-  require(std::isfinite(odometry_sigma_translation) && odometry_sigma_translation >= 0.0,
-          "local_mapping.odometry_sigma_translation", ">= 0 m (0 = off)");
-  require(std::isfinite(odometry_sigma_rotation) && odometry_sigma_rotation >= 0.0,
-          "local_mapping.odometry_sigma_rotation", ">= 0 rad (0 = off)");
+  pairs.validate();
   require(min_found_ratio >= 0.0 && min_found_ratio <= 1.0, "local_mapping.min_found_ratio", "in [0, 1]");
   require(redundant_ratio > 0.0 && redundant_ratio <= 1.0, "local_mapping.redundant_ratio", "in (0, 1]");
   require(place_distance_ratio > 0.0 && place_distance_ratio < 1.0, "local_mapping.place_distance_ratio",

@@ -5,7 +5,6 @@
 #include "rgbl/map/fusion.hpp"
 
 #include <algorithm>
-#include <optional>
 #include <cmath>
 #include <numbers>
 #include <mutex>
@@ -157,49 +156,7 @@ int LocalMapper::local_bundle_adjustment(KeyframeId id, double& elapsed_ms) {
       const auto oldest = std::min_element(bundle.keyframes.begin(), bundle.keyframes.end());
       poses[static_cast<std::size_t>(oldest - bundle.keyframes.begin())].fixed = true;
     }
-    if (options_.road_sigma_offset > 0.0 && options_.road_sigma_tilt_deg > 0.0) {
-      // each optimised keyframe against the newest older keyframe of the problem that saw the road
-      // close enough to share it
-      for (std::size_t i = 0; i < poses.size(); ++i) {
-        const Keyframe* kf = map_.keyframe(bundle.keyframes[i]);
-        if (poses[i].fixed || kf == nullptr || !kf->road) continue;
-        std::optional<std::size_t> older;
-        for (std::size_t j = 0; j < poses.size(); ++j) {
-          const Keyframe* other = map_.keyframe(bundle.keyframes[j]);
-          if (j == i || other == nullptr || !other->road || !(bundle.keyframes[j] < bundle.keyframes[i])) continue;
-          if ((other->center() - kf->center()).norm() > options_.road_max_distance) continue;
-          if (!older || bundle.keyframes[*older] < bundle.keyframes[j]) older = j;
-        }
-        if (!older) continue;
-        BundlePlanePair pair;
-        pair.pose_a = static_cast<int>(*older);
-        pair.pose_b = static_cast<int>(i);
-        pair.plane_a = *map_.keyframe(bundle.keyframes[*older])->road;
-        pair.plane_b = *kf->road;
-        pair.sigma_offset = options_.road_sigma_offset;
-        pair.sigma_tilt = options_.road_sigma_tilt_deg * std::numbers::pi / 180.0;
-        bundle.problem.plane_pairs.push_back(pair);
-      }
-    }
-    if (options_.odometry_sigma_translation > 0.0 && options_.odometry_sigma_rotation > 0.0) {
-      // each optimised keyframe to the one before it, by the motion tracking measured between them
-      for (std::size_t i = 0; i < poses.size(); ++i) {
-        const Keyframe* kf = map_.keyframe(bundle.keyframes[i]);
-        if (poses[i].fixed || kf == nullptr || !kf->previous.valid()) continue;
-        const auto previous = std::find(bundle.keyframes.begin(), bundle.keyframes.end(), kf->previous);
-        if (previous == bundle.keyframes.end()) continue;
-        BundlePosePair pair;
-        pair.pose_a = static_cast<int>(previous - bundle.keyframes.begin());
-        pair.pose_b = static_cast<int>(i);
-        pair.T_b_a = kf->T_cam_previous;
-        pair.sigma_translation = options_.odometry_sigma_translation;
-        pair.sigma_rotation = options_.odometry_sigma_rotation;
-        // where both saw the road, it decides height and tilt (a truck beside the car lifted tracked
-        // steps by 0.2-0.3 m; the road planes agree within 0.05 m)
-        pair.level_only = kf->road && map_.keyframe(kf->previous)->road;
-        bundle.problem.pose_pairs.push_back(pair);
-      }
-    }
+    add_keyframe_pairs(map_, bundle, options_.pairs);
   }
   const BundleAdjustmentResult result = bundle_adjust(camera_, bundle.problem, options_.ba, &abort_);
   int outliers = 0;

@@ -4,6 +4,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <limits>
+
 namespace {
 
 // Fills `map` with the scene with every keyframe at `T_cam_world[k]` and one landmark per point, observed by
@@ -113,4 +115,74 @@ TEST_CASE("map bundle: a window adds only its own landmarks, anchors add observa
     CHECK(bundle.observations[o].first == bundle.landmarks[static_cast<std::size_t>(obs.point)]);
     CHECK(obs.depth > 0.0);  // every keypoint of the scene has depth
   }
+}
+
+TEST_CASE("map bundle: keyframe pairs join each optimised keyframe to the road before it and to its previous keyframe") {
+  rgbl::test::PointsMap s = rgbl::test::make_points_map(4, 80);
+  std::vector<rgbl::KeyframeId> keyframes;
+  std::vector<rgbl::LandmarkId> landmarks;
+  rgbl::Map map;
+  fill_map(map, s, s.T_cam_world, s.points, keyframes, landmarks);
+  // keyframes 0-2 saw the road, 1.65 m below; keyframe 3 did not. Each was made from the one before.
+  for (std::size_t k = 0; k < keyframes.size(); ++k) {
+    rgbl::Keyframe& kf = *map.keyframe(keyframes[k]);
+    if (k < 3) kf.road = Eigen::Vector4d(0.0, 1.0, 0.0, 1.65);
+    if (k > 0) {
+      kf.previous = keyframes[k - 1];
+      kf.T_cam_previous = s.T_cam_world[k] * s.T_cam_world[k - 1].inverse();
+    }
+  }
+  const std::vector<rgbl::KeyframeId> window = {keyframes[3], keyframes[1], keyframes[2]};
+  const std::vector<rgbl::KeyframeId> anchors = {keyframes[0]};
+  rgbl::MapBundle bundle = rgbl::make_map_bundle(map, window, anchors);
+  REQUIRE(bundle.keyframes == std::vector<rgbl::KeyframeId>{keyframes[3], keyframes[1], keyframes[2], keyframes[0]});
+  rgbl::KeyframePairOptions options;
+  rgbl::add_keyframe_pairs(map, bundle, options);
+
+  // road: 1 with 0 (the fixed anchor), 2 with 1 (the newest older one, not 0); 3 has no road
+  const auto& planes = bundle.problem.plane_pairs;
+  REQUIRE(planes.size() == 2);
+  CHECK((planes[0].pose_a == 3 && planes[0].pose_b == 1));
+  CHECK((planes[1].pose_a == 1 && planes[1].pose_b == 2));
+  CHECK(planes[0].sigma_offset == options.road_sigma_offset);
+  CHECK(planes[0].sigma_tilt == Approx(options.road_sigma_tilt_deg * 3.14159265358979 / 180.0));
+  // motion: each optimised keyframe with its previous one; level only where both saw the road
+  const auto& motions = bundle.problem.pose_pairs;
+  REQUIRE(motions.size() == 3);
+  CHECK((motions[0].pose_a == 2 && motions[0].pose_b == 0 && !motions[0].level_only));
+  CHECK((motions[1].pose_a == 3 && motions[1].pose_b == 1 && motions[1].level_only));
+  CHECK((motions[2].pose_a == 1 && motions[2].pose_b == 2 && motions[2].level_only));
+  CHECK(motions[0].T_b_a.isApprox(map.keyframe(keyframes[3])->T_cam_previous));
+  CHECK(motions[0].sigma_translation == options.odometry_sigma_translation);
+
+  // a previous keyframe outside the problem, a road too far away, or a sigma of 0: no pair
+  bundle = rgbl::make_map_bundle(map, std::vector<rgbl::KeyframeId>{keyframes[2]}, std::vector<rgbl::KeyframeId>{keyframes[0]});
+  options.road_max_distance = 0.9;  // keyframe 0 is 1 m behind keyframe 2
+  rgbl::add_keyframe_pairs(map, bundle, options);
+  CHECK(bundle.problem.plane_pairs.empty());
+  CHECK(bundle.problem.pose_pairs.empty());
+  bundle = rgbl::make_map_bundle(map, window, anchors);
+  options = {};
+  options.road_sigma_tilt_deg = 0.0;
+  options.odometry_sigma_rotation = 0.0;
+  rgbl::add_keyframe_pairs(map, bundle, options);
+  CHECK(bundle.problem.plane_pairs.empty());
+  CHECK(bundle.problem.pose_pairs.empty());
+}
+
+TEST_CASE("keyframe pair options are checked, naming the field, and 0 turns a pair kind off") {
+  rgbl::KeyframePairOptions o;
+  CHECK_NOTHROW(o.validate());
+  o.road_sigma_offset = -0.1;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("keyframe_pairs.road_sigma_offset"));
+  o = {};
+  o.road_max_distance = 0.0;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("keyframe_pairs.road_max_distance"));
+  o = {};
+  o.odometry_sigma_rotation = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("keyframe_pairs.odometry_sigma_rotation"));
+  o = {};
+  o.road_sigma_offset = 0.0;
+  o.odometry_sigma_translation = 0.0;
+  CHECK_NOTHROW(o.validate());
 }

@@ -155,6 +155,7 @@ TEST_CASE("loop closing options are checked, naming the field") {
   refused([](auto& o) { o.fusion_neighbours = -1; }, "loop_closing.fusion_neighbours");
   refused([](auto& o) { o.fusion.radius_px = 0.0; }, "fusion.radius_px");
   refused([](auto& o) { o.global_ba_options.iterations = 0; }, "bundle_adjustment.iterations");
+  refused([](auto& o) { o.global_ba_pairs.road_max_distance = -1.0; }, "keyframe_pairs.road_max_distance");
   refused([](auto& o) { o.max_drift_percent = 0.0; }, "loop_closing.max_drift_percent");
   refused([](auto& o) { o.max_drift_deg_per_100m = -1.0; }, "loop_closing.max_drift_deg_per_100m");
   refused([](auto& o) { o.drift_allowance_m = -0.1; }, "loop_closing.drift_allowance_m");

@@ -107,29 +107,11 @@ TEST_CASE("revisit culling options are checked, naming the field") {
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.max_keyframes_per_place"));
 }
 
-TEST_CASE("road pair options are checked, naming the field, and 0 turns the pairs off") {
+TEST_CASE("local mapping checks its keyframe pair options (naming the field)") {
   rgbl::LocalMappingOptions o;
-  o.road_sigma_offset = -0.1;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.road_sigma_offset"));
+  o.pairs.road_sigma_tilt_deg = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("keyframe_pairs.road_sigma_tilt_deg"));
   o = {};
-  o.road_sigma_tilt_deg = std::numeric_limits<double>::quiet_NaN();
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.road_sigma_tilt_deg"));
-  o = {};
-  o.road_max_distance = 0.0;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.road_max_distance"));
-  o = {};
-  o.road_sigma_offset = 0.0;
-  CHECK_NOTHROW(o.validate());
-}
-
-TEST_CASE("keyframe motion pair options are checked, naming the field, and 0 turns the pairs off") {
-  rgbl::LocalMappingOptions o;
-  o.odometry_sigma_translation = -0.05;
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.odometry_sigma_translation"));
-  o = {};
-  o.odometry_sigma_rotation = std::numeric_limits<double>::infinity();
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("local_mapping.odometry_sigma_rotation"));
-  o = {};
-  o.odometry_sigma_translation = 0.0;
-  CHECK_NOTHROW(o.validate());
+  o.pairs.odometry_sigma_translation = -0.05;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("keyframe_pairs.odometry_sigma_translation"));
 }

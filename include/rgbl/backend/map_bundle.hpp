@@ -28,6 +28,36 @@ struct MapBundle {
 MapBundle make_map_bundle(const Map& map, std::span<const KeyframeId> window, std::span<const KeyframeId> anchors,
                           KeyframeId held = {});
 
+// What ties keyframes to one another besides the landmarks they share: the measurements local BA
+// and the global BA after a loop add between keyframes (0 in a pair kind's sigma turns it off).
+struct KeyframePairOptions {
+  // The road: each optimised keyframe with a road plane in its scan is paired with the newest older
+  // keyframe of the problem that has one (BundlePlanePair), fixing their relative height and tilt.
+  // Where keyframes share few points (a car ahead hides the street) a window otherwise drifts up or
+  // down as a whole. Sigmas from KITTI 04's ground truth, road planes 5-10 frames apart (0.04-0.07 m,
+  // 0.4-0.6 deg median).
+  double road_sigma_offset = 0.05;   // m
+  double road_sigma_tilt_deg = 0.5;  // deg
+  double road_max_distance = 20.0;   // m between the two: each plane is fitted to returns within 40 m
+  // The motion tracking measured from the keyframe before (Keyframe::previous) ties each optimised
+  // keyframe to that one (BundlePosePair). Landmarks seen by fewer than 3 keyframes are culled, and
+  // with them most of what tied a keyframe to the one before: on the simulator's 400 m loop 18 points
+  // tied a window to its fixed keyframes, and local BA moved new keyframes 0.1-0.3 m sideways against
+  // a step tracking had right. Where both keyframes saw the road, the pair leaves height and tilt to
+  // the road pair. Sigmas per axis between two keyframes; 0.1 m chosen over 0.05 m on the whole suite
+  // and the loop table (docs/accuracy.md, "Keyframes keep the tracked motion").
+  double odometry_sigma_translation = 0.1;  // m
+  double odometry_sigma_rotation = 0.005;   // rad
+
+  void validate() const;  // throws ConfigError naming the field
+};
+
+// Adds the pairs of KeyframePairOptions to the bundle's problem for each keyframe it optimises: a
+// road pair with the newest older keyframe of the problem that saw the road within
+// road_max_distance, and a motion pair with its previous keyframe if that is in the problem (level
+// only where both saw the road). Call with the map's lock held (shared is enough).
+void add_keyframe_pairs(const Map& map, MapBundle& bundle, const KeyframePairOptions& options);
+
 // Writes the solved poses (not the fixed ones) and points back, erases the observations the solve
 // called outliers and, when there were any, recomputes the covisibility of the bundle's keyframes.
 // Returns how many observations it erased. Elements erased meanwhile are skipped. Call with the map's

@@ -4,6 +4,7 @@
 
 #include "rgbl/backend/bundle_adjustment.hpp"
 #include "rgbl/backend/depth_noise.hpp"
+#include "rgbl/backend/map_bundle.hpp"
 #include "rgbl/backend/pose_optimizer.hpp"
 #include "rgbl/geometry/scan_agreement.hpp"
 #include "rgbl/map/fusion.hpp"
@@ -165,23 +166,7 @@ struct LocalMappingOptions {
   FusionOptions fusion_match;           // 3 px at level 0, Hamming <= 50
   int max_local_ba_keyframes = 10;      // optimised keyframes (the current one and its best covisible)
   int max_fixed_keyframes = 20;
-  // The road ties the local BA's keyframes in height and tilt: each optimised keyframe with a road in
-  // its scan is paired with the newest older one in the window or its anchors (BundlePlanePair).
-  // Where the keyframes share few points (a car ahead hides the street) the window otherwise drifts
-  // up or down as a whole. Sigmas from KITTI 04's ground truth, road planes 5-10 frames apart
-  // (0.04-0.07 m, 0.4-0.6 deg median); 0 = off.
-  double road_sigma_offset = 0.05;   // m
-  double road_sigma_tilt_deg = 0.5;  // deg
-  double road_max_distance = 20.0;   // m between the two: each plane is fitted to returns within 40 m
-  // The motion tracking measured from the keyframe before (its reference when it was made) ties each
-  // optimised keyframe to that one (BundlePosePair). Landmarks seen by fewer than 3 keyframes are
-  // culled, and with them most of what tied a keyframe to the one before: on the simulator's 400 m loop
-  // 18 points tied a window to its fixed keyframes, and local BA moved new keyframes 0.1-0.3 m sideways
-  // against a step tracking had right. Where both keyframes saw the road, the pair leaves height and
-  // tilt to the road pair. Sigmas per axis between two keyframes; 0.1 m chosen over 0.05 m on the
-  // whole suite and the loop table (docs/accuracy.md, "Keyframes keep the tracked motion"); 0 = off.
-  double odometry_sigma_translation = 0.1;   // m
-  double odometry_sigma_rotation = 0.005;    // rad
+  KeyframePairOptions pairs;            // the road and the tracked motion between keyframes
   double min_found_ratio = 0.25;        // landmark culling
   int min_observations = 3;             // landmark culling after 2 keyframes
   double redundant_ratio = 0.9;         // keyframe culling
