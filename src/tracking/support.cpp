@@ -24,6 +24,17 @@ TrackState support_state(int inliers, std::optional<std::size_t> frames_since_re
   return inliers >= needed ? TrackState::Ok : TrackState::Weak;
 }
 
+bool keyframe_due(const KeyframeEvidence& e, const TrackerOptions& options) {
+  const bool need_close =
+      e.tracked_close < options.close_tracked_threshold && e.untracked_close > options.close_untracked_threshold;
+  const double ratio = e.keyframes < 2 ? options.initial_reference_ratio_threshold : options.reference_ratio_threshold;
+  const bool c1a = e.frames_since_keyframe >= options.max_frames_between_keyframes;
+  const bool c1c = e.established_inliers < options.urgent_reference_ratio * e.reference_established || need_close;
+  const bool c2 = (e.established_inliers < ratio * e.reference_established || need_close) &&
+                  e.inliers > options.min_keyframe_inliers;
+  return (c1a || e.mapping_idle || c1c) && c2;
+}
+
 double allowed_step(double predicted_step_m, double dt, const TrackerOptions& options) {
   const double acceleration_term = dt > 0.0 ? 0.5 * options.max_acceleration * dt * dt : 0.0;
   return options.step_tolerance + options.step_tolerance_relative * std::max(0.0, predicted_step_m) + acceleration_term;

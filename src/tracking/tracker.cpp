@@ -16,6 +16,7 @@
 #include <mutex>
 #include <shared_mutex>
 #include <span>
+#include <utility>
 
 namespace rgbl {
 
@@ -888,29 +889,32 @@ bool Tracker::relocalise(Frame& frame) const {
 bool Tracker::need_keyframe(const Frame& frame, int inliers, bool mapping_idle) const {
   std::shared_lock lock(map_.mutex());
   const int keyframes = static_cast<int>(map_.keyframe_count());
-  const auto since_last = static_cast<int>(frame.index - last_keyframe_frame_);
   if (last_relocalisation_frame_ > 0 &&
       frame.index < last_relocalisation_frame_ + static_cast<std::size_t>(options_.max_frames_between_keyframes) &&
       keyframes > options_.max_frames_between_keyframes) {
     return false;
   }
+  KeyframeEvidence e;
+  e.keyframes = keyframes;
+  e.frames_since_keyframe = static_cast<int>(frame.index - last_keyframe_frame_);
+  e.mapping_idle = mapping_idle;
+  e.inliers = inliers;
+  // established: seen by 3 keyframes (2 while the map has two or fewer); the frame's inliers are
+  // counted the same way as the reference's landmarks (TrackerOptions::reference_ratio_threshold)
   const int min_observations = keyframes <= 2 ? 2 : 3;
   const Keyframe* ref = map_.keyframe(reference_);
-  const int reference_matches = ref != nullptr ? ref->tracked_landmarks(min_observations, map_) : 0;
-  int tracked_close = 0, untracked_close = 0;
+  e.reference_established = ref != nullptr ? ref->tracked_landmarks(min_observations, map_) : 0;
   for (std::size_t i = 0; i < frame.size(); ++i) {
+    const bool tracked = frame.landmarks[i].valid() && !frame.outlier[i];
+    if (tracked) {
+      const Landmark* l = map_.landmark(frame.landmarks[i]);
+      if (l != nullptr && std::cmp_greater_equal(l->observations.size(), min_observations)) ++e.established_inliers;
+    }
     if (frame.depth_sigma[i] <= 0.0F || frame.depth[i] >= options_.close_depth) continue;
-    if (frame.landmarks[i].valid() && !frame.outlier[i]) ++tracked_close;
-    else ++untracked_close;
+    if (tracked) ++e.tracked_close;
+    else ++e.untracked_close;
   }
-  const bool need_close =
-      tracked_close < options_.close_tracked_threshold && untracked_close > options_.close_untracked_threshold;
-  const double ratio = keyframes < 2 ? options_.initial_reference_ratio_threshold : options_.reference_ratio_threshold;
-  const bool c1a = since_last >= options_.max_frames_between_keyframes;
-  const bool c1b = mapping_idle;
-  const bool c1c = inliers < options_.urgent_reference_ratio * reference_matches || need_close;
-  const bool c2 = (inliers < ratio * reference_matches || need_close) && inliers > options_.min_keyframe_inliers;
-  return (c1a || c1b || c1c) && c2;
+  return keyframe_due(e, options_);
 }
 
 KeyframeId Tracker::make_keyframe(const Frame& frame) {

@@ -86,3 +86,57 @@ TEST_CASE("support: the thresholds are validated", "[tracking][support]") {
   CHECK_THROWS_WITH(options.validate(), Catch::Contains("tracker.max_acceleration"));
   CHECK_NOTHROW(rgbl::TrackerOptions{}.validate());
 }
+
+TEST_CASE("keyframe rule: like with like, established inliers against the reference's established landmarks",
+          "[tracking][support]") {
+  const rgbl::TrackerOptions options;  // 0.3 of the reference's established, 0.25 urgent, 10 frames
+  rgbl::KeyframeEvidence e;
+  e.keyframes = 20;
+  e.frames_since_keyframe = 10;
+  e.reference_established = 150;
+  e.inliers = 500;  // young landmarks from the last keyframe's depth: most of them
+  e.established_inliers = 46;
+  e.tracked_close = 300;  // no need for close points
+  e.untracked_close = 10;
+  // 46 of 150 established still tracked (> 30 %): no keyframe, however many young ones are tracked
+  CHECK_FALSE(rgbl::keyframe_due(e, options));
+  e.established_inliers = 44;  // < 45
+  CHECK(rgbl::keyframe_due(e, options));
+  // ORB-SLAM's count (every inlier against 75 %) would wait: 500 inliers are not < 112
+  e.inliers = 100;
+  CHECK(rgbl::keyframe_due(e, options));
+  // before max_frames_between_keyframes, with mapping busy: only when urgent (< 25 %, 37.5)
+  e.frames_since_keyframe = 3;
+  CHECK_FALSE(rgbl::keyframe_due(e, options));
+  e.mapping_idle = true;
+  CHECK(rgbl::keyframe_due(e, options));
+  e.mapping_idle = false;
+  e.established_inliers = 37;
+  CHECK(rgbl::keyframe_due(e, options));
+  // never on min_keyframe_inliers (15) inliers or fewer
+  e.inliers = 15;
+  CHECK_FALSE(rgbl::keyframe_due(e, options));
+  // close points needed: < 100 tracked and > 70 untracked within close_depth make one due at once
+  e = {};
+  e.keyframes = 20;
+  e.frames_since_keyframe = 1;
+  e.reference_established = 150;
+  e.inliers = 400;
+  e.established_inliers = 140;
+  e.tracked_close = 99;
+  e.untracked_close = 71;
+  CHECK(rgbl::keyframe_due(e, options));
+  e.untracked_close = 70;
+  CHECK_FALSE(rgbl::keyframe_due(e, options));
+  // while the map has one keyframe: 40 % (initial_reference_ratio_threshold)
+  e = {};
+  e.keyframes = 1;
+  e.frames_since_keyframe = 10;
+  e.reference_established = 100;
+  e.inliers = 300;
+  e.tracked_close = 300;
+  e.established_inliers = 40;
+  CHECK_FALSE(rgbl::keyframe_due(e, options));
+  e.established_inliers = 39;
+  CHECK(rgbl::keyframe_due(e, options));
+}

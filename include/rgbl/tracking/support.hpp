@@ -1,6 +1,6 @@
 #pragma once
-// The rule that says how far a tracked frame's pose can be trusted, as pure functions so that it is
-// stated once and unit-tested on its own.
+// The rules that say how far a tracked frame's pose can be trusted and when it becomes a keyframe, as
+// pure functions so that each is stated once and unit-tested on its own.
 //
 // A frame is `ok` only with enough support: ORB-SLAM's thresholds, min_ok_inliers (30) map-point
 // inliers, and min_ok_inliers_after_relocalisation (50) for relocalisation_window frames after a
@@ -29,6 +29,25 @@ constexpr bool has_pose(TrackState state) { return state == TrackState::Ok || st
 // empty when there was none (0 = this frame was relocalised).
 TrackState support_state(int inliers, std::optional<std::size_t> frames_since_relocalisation,
                          const TrackerOptions& options);
+
+// What the keyframe decision looks at, counted on the frame just tracked.
+struct KeyframeEvidence {
+  int keyframes = 0;              // in the map
+  int frames_since_keyframe = 0;
+  bool mapping_idle = false;
+  int reference_established = 0;  // the reference keyframe's landmarks seen by enough keyframes
+  int inliers = 0;                // the frame's inliers on landmarks...
+  int established_inliers = 0;    // ...and those on landmarks seen by enough keyframes
+  int tracked_close = 0, untracked_close = 0;  // keypoints with depth under close_depth
+};
+
+// ORB-SLAM3's RGB-D keyframe rule (SPEC 5) counted like with like: a keyframe is due when the frame
+// tracks fewer than reference_ratio_threshold (initial_reference_ratio_threshold while the map has
+// one keyframe) of the reference keyframe's established landmarks, counting only its own inliers on
+// established landmarks, or needs close points; and max_frames_between_keyframes have passed,
+// mapping is idle or it is urgent (urgent_reference_ratio); never on min_keyframe_inliers inliers or
+// fewer.
+bool keyframe_due(const KeyframeEvidence& e, const TrackerOptions& options);
 
 // How far (m) a camera centre may end up from the constant-velocity prediction of a step of
 // predicted_step_m over dt seconds: step_tolerance + step_tolerance_relative * step + max_acceleration
