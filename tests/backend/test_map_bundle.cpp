@@ -27,6 +27,15 @@ void fill_map(rgbl::Map& map, rgbl::test::PointsMap& s, const std::vector<Eigen:
   for (const auto k : keyframes) map.update_covisibility(k);
 }
 
+// The scene's map with every keyframe and landmark at the truth.
+struct TruthMap {
+  rgbl::test::PointsMap s = rgbl::test::make_points_map(4, 80);
+  std::vector<rgbl::KeyframeId> keyframes;
+  std::vector<rgbl::LandmarkId> landmarks;
+  rgbl::Map map;
+  TruthMap() { fill_map(map, s, s.T_cam_world, s.points, keyframes, landmarks); }
+};
+
 Eigen::Isometry3d perturbed(const Eigen::Isometry3d& T, double metres, double radians) {
   Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
   D.linear() = Eigen::AngleAxisd(radians, Eigen::Vector3d(0.3, 1.0, -0.2).normalized()).toRotationMatrix();
@@ -90,11 +99,8 @@ TEST_CASE("map bundle: the whole map adjusted back to the truth, the held keyfra
 }
 
 TEST_CASE("map bundle: a window adds only its own landmarks, anchors add observations and stay fixed") {
-  rgbl::test::PointsMap s = rgbl::test::make_points_map(4, 80);
-  std::vector<rgbl::KeyframeId> keyframes;
-  std::vector<rgbl::LandmarkId> landmarks;
-  rgbl::Map map;
-  fill_map(map, s, s.T_cam_world, s.points, keyframes, landmarks);
+  TruthMap truth;
+  const auto& [s, keyframes, landmarks, map] = truth;
   const std::vector<rgbl::KeyframeId> window = {keyframes[3], keyframes[2]};
   const std::vector<rgbl::KeyframeId> anchors = {keyframes[0], keyframes[3]};  // a window keyframe is not repeated
   const rgbl::MapBundle bundle = rgbl::make_map_bundle(map, window, anchors);
@@ -118,11 +124,8 @@ TEST_CASE("map bundle: a window adds only its own landmarks, anchors add observa
 }
 
 TEST_CASE("map bundle: keyframe pairs join each optimised keyframe to the road before it and to its previous keyframe") {
-  rgbl::test::PointsMap s = rgbl::test::make_points_map(4, 80);
-  std::vector<rgbl::KeyframeId> keyframes;
-  std::vector<rgbl::LandmarkId> landmarks;
-  rgbl::Map map;
-  fill_map(map, s, s.T_cam_world, s.points, keyframes, landmarks);
+  TruthMap truth;
+  auto& [s, keyframes, landmarks, map] = truth;
   // keyframes 0-2 saw the road, 1.65 m below; keyframe 3 did not. Each was made from the one before.
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     rgbl::Keyframe& kf = *map.keyframe(keyframes[k]);

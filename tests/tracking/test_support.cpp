@@ -90,20 +90,15 @@ TEST_CASE("support: the thresholds are validated", "[tracking][support]") {
 TEST_CASE("keyframe rule: like with like, established inliers against the reference's established landmarks",
           "[tracking][support]") {
   const rgbl::TrackerOptions options;  // 0.3 of the reference's established, 0.25 urgent, 10 frames
-  rgbl::KeyframeEvidence e;
-  e.keyframes = 20;
-  e.frames_since_keyframe = 10;
-  e.reference_established = 150;
-  e.inliers = 500;  // young landmarks from the last keyframe's depth: most of them
-  e.established_inliers = 46;
-  e.tracked_close = 300;  // no need for close points
-  e.untracked_close = 10;
-  // 46 of 150 established still tracked (> 30 %): no keyframe, however many young ones are tracked
-  CHECK_FALSE(rgbl::keyframe_due(e, options));
-  e.established_inliers = 44;  // < 45
+  // 10 frames after the last keyframe, mapping busy, no need for close points; 500 inliers, most of
+  // them on young landmarks from the last keyframe's depth, 46 of the reference's 150 established
+  rgbl::KeyframeEvidence e{.keyframes = 20, .frames_since_keyframe = 10, .mapping_idle = false,
+                           .reference_established = 150, .inliers = 500, .established_inliers = 46,
+                           .tracked_close = 300, .untracked_close = 10};
+  CHECK_FALSE(rgbl::keyframe_due(e, options));  // > 30 % still tracked, however many young ones
+  e.established_inliers = 44;                    // < 45
   CHECK(rgbl::keyframe_due(e, options));
-  // ORB-SLAM's count (every inlier against 75 %) would wait: 500 inliers are not < 112
-  e.inliers = 100;
+  e.inliers = 100;  // ORB-SLAM's count (every inlier against 75 %) would have waited for < 112
   CHECK(rgbl::keyframe_due(e, options));
   // before max_frames_between_keyframes, with mapping busy: only when urgent (< 25 %, 37.5)
   e.frames_since_keyframe = 3;
@@ -113,30 +108,22 @@ TEST_CASE("keyframe rule: like with like, established inliers against the refere
   e.mapping_idle = false;
   e.established_inliers = 37;
   CHECK(rgbl::keyframe_due(e, options));
-  // never on min_keyframe_inliers (15) inliers or fewer
-  e.inliers = 15;
+  e.inliers = 15;  // never on min_keyframe_inliers (15) inliers or fewer
   CHECK_FALSE(rgbl::keyframe_due(e, options));
-  // close points needed: < 100 tracked and > 70 untracked within close_depth make one due at once
-  e = {};
-  e.keyframes = 20;
-  e.frames_since_keyframe = 1;
-  e.reference_established = 150;
-  e.inliers = 400;
-  e.established_inliers = 140;
-  e.tracked_close = 99;
-  e.untracked_close = 71;
-  CHECK(rgbl::keyframe_due(e, options));
-  e.untracked_close = 70;
-  CHECK_FALSE(rgbl::keyframe_due(e, options));
+
+  // close points needed (< 100 tracked and > 70 untracked within close_depth): due at once
+  rgbl::KeyframeEvidence close{.keyframes = 20, .frames_since_keyframe = 1, .mapping_idle = false,
+                               .reference_established = 150, .inliers = 400, .established_inliers = 140,
+                               .tracked_close = 99, .untracked_close = 71};
+  CHECK(rgbl::keyframe_due(close, options));
+  close.untracked_close = 70;
+  CHECK_FALSE(rgbl::keyframe_due(close, options));
+
   // while the map has one keyframe: 40 % (initial_reference_ratio_threshold)
-  e = {};
-  e.keyframes = 1;
-  e.frames_since_keyframe = 10;
-  e.reference_established = 100;
-  e.inliers = 300;
-  e.tracked_close = 300;
-  e.established_inliers = 40;
-  CHECK_FALSE(rgbl::keyframe_due(e, options));
-  e.established_inliers = 39;
-  CHECK(rgbl::keyframe_due(e, options));
+  rgbl::KeyframeEvidence second{.keyframes = 1, .frames_since_keyframe = 10, .mapping_idle = false,
+                                .reference_established = 100, .inliers = 300, .established_inliers = 40,
+                                .tracked_close = 300, .untracked_close = 0};
+  CHECK_FALSE(rgbl::keyframe_due(second, options));
+  second.established_inliers = 39;
+  CHECK(rgbl::keyframe_due(second, options));
 }
