@@ -218,21 +218,22 @@ BundleAdjustmentResult bundle_adjust(const PinholeCamera& camera, BundleProblem&
     const auto ia = static_cast<std::size_t>(a), ib = static_cast<std::size_t>(b);
     return a >= 0 && b >= 0 && ia < poses.size() && ib < poses.size() && ia != ib && pose_used[ia] && pose_used[ib];
   };
+  // a pair's cost on the rotation and translation blocks of its two poses
+  const auto add_pair = [&](ceres::CostFunction* cost, double delta, int a, int b) {
+    const auto ia = static_cast<std::size_t>(a), ib = static_cast<std::size_t>(b);
+    ceres_problem.AddResidualBlock(cost, new ceres::HuberLoss(delta), poses[ia].data(), poses[ia].data() + 3,
+                                   poses[ib].data(), poses[ib].data() + 3);
+  };
   for (const BundlePlanePair& pair : problem.plane_pairs) {
     if (!usable(pair.pose_a, pair.pose_b)) continue;
-    const auto ia = static_cast<std::size_t>(pair.pose_a), ib = static_cast<std::size_t>(pair.pose_b);
-    ceres_problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlanePairCost, 3, 3, 3, 3, 3>(new PlanePairCost(pair)),
-                                   new ceres::HuberLoss(delta3), poses[ia].data(), poses[ia].data() + 3,
-                                   poses[ib].data(), poses[ib].data() + 3);
+    add_pair(new ceres::AutoDiffCostFunction<PlanePairCost, 3, 3, 3, 3, 3>(new PlanePairCost(pair)), delta3,
+             pair.pose_a, pair.pose_b);
   }
-
   const double delta6 = std::sqrt(12.592);  // 95 % of chi2 with 6 dof
   for (const BundlePosePair& pair : problem.pose_pairs) {
     if (!usable(pair.pose_a, pair.pose_b)) continue;
-    const auto ia = static_cast<std::size_t>(pair.pose_a), ib = static_cast<std::size_t>(pair.pose_b);
-    ceres_problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PosePairCost, 6, 3, 3, 3, 3>(new PosePairCost(pair)),
-                                   new ceres::HuberLoss(delta6), poses[ia].data(), poses[ia].data() + 3,
-                                   poses[ib].data(), poses[ib].data() + 3);
+    add_pair(new ceres::AutoDiffCostFunction<PosePairCost, 6, 3, 3, 3, 3>(new PosePairCost(pair)), delta6,
+             pair.pose_a, pair.pose_b);
   }
 
   ceres::Solver::Options solver_options;

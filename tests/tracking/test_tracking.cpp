@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <random>
 #include <stdexcept>
@@ -38,15 +39,40 @@ rgbl::CameraCalibration small_camera() {
 }
 
 // Frames built outside the System, as a caller with its own threads would: LiDAR depth, ORB features.
-rgbl::FrameBuilder lidar_frame_builder(const rgbl::CameraCalibration& calibration, const rgbl::SystemOptions& options) {
-  rgbl::DepthSourceContext context;
-  context.calibration = calibration;
-  auto orb = std::make_shared<rgbl::OrbExtractor>();
-  return rgbl::FrameBuilder(calibration, options.depth_noise, rgbl::make_lidar_source({}, context),
-                            [orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
-                              orb->extract(g, k, d);
-                            });
-}
+// Sequence 04's camera 0 tracked by a System without a depth source of its own: each frame is built
+// outside it (LiDAR depth, ORB) and handed over.
+struct BuiltSeq04 {
+  std::unique_ptr<rgbl::Sequence> sequence;
+  rgbl::CameraCalibration calibration;
+  rgbl::SystemOptions options;
+  rgbl::FrameBuilder builder;
+  rgbl::System system;
+  rgbl::FrameInput input;  // the loaded frame's images, which the SensorFrame views
+
+  explicit BuiltSeq04(const std::filesystem::path& dir)
+      : sequence(rgbl::open_kitti_odometry(dir)),
+        calibration(sequence->calibration().camera(0)),
+        builder(make_builder(calibration, options)),
+        system(options, calibration) {}
+
+  rgbl::SensorFrame load(std::size_t i) {
+    input = sequence->load(i);
+    rgbl::SensorFrame frame = rgbl::test::sensor_frame(input, 0);
+    frame.index = i;
+    return frame;
+  }
+  rgbl::TrackResult track(const rgbl::SensorFrame& frame) { return system.track(frame, builder.build(frame)); }
+
+  static rgbl::FrameBuilder make_builder(const rgbl::CameraCalibration& calibration, const rgbl::SystemOptions& options) {
+    rgbl::DepthSourceContext context;
+    context.calibration = calibration;
+    auto orb = std::make_shared<rgbl::OrbExtractor>();
+    return rgbl::FrameBuilder(calibration, options.depth_noise, rgbl::make_lidar_source({}, context),
+                              [orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
+                                orb->extract(g, k, d);
+                              });
+  }
+};
 
 }  // namespace
 
@@ -174,21 +200,16 @@ TEST_CASE("relocalisation neither changes nor depends on the caller's OpenCV gen
 TEST_CASE("a System without a depth source of its own tracks built frames, the same as one with it") {
   const auto dir = rgbl::test::kitti_seq04();
   if (!dir) return;
-  const auto sequence = rgbl::open_kitti_odometry(*dir);
-  const rgbl::CameraCalibration calibration = sequence->calibration().camera(0);
-  const rgbl::SystemOptions options;
-  rgbl::FrameBuilder builder = lidar_frame_builder(calibration, options);
-  rgbl::System system(options, calibration);
+  BuiltSeq04 t(*dir);
   constexpr std::size_t kFrames = 12;
   for (std::size_t i = 0; i < kFrames; ++i) {
-    const rgbl::FrameInput input = sequence->load(i);
-    rgbl::SensorFrame frame = rgbl::test::sensor_frame(input, 0);
-    frame.index = i;
-    if (i == 0) CHECK_THROWS_AS(system.track(frame), std::logic_error);  // nothing to build it with
-    CHECK(rgbl::has_pose(system.track(frame, builder.build(frame)).state));
+    const rgbl::SensorFrame frame = t.load(i);
+    if (i == 0) CHECK_THROWS_AS(t.system.track(frame), std::logic_error);  // nothing to build it with
+    CHECK(rgbl::has_pose(t.track(frame).state));
   }
   const auto own = rgbl::test::run_sequence(*dir, 0, kFrames);
-  const auto built = system.trajectory();
+  const rgbl::CameraCalibration& calibration = t.calibration;
+  const auto built = t.system.trajectory();
   REQUIRE(built.size() == kFrames);
   for (std::size_t i = 0; i < kFrames; ++i) {
     const Eigen::Isometry3d T_world_cam0 = calibration.T_cam_cam0.inverse() * built[i].T_world_cam * calibration.T_cam_cam0;
@@ -199,18 +220,9 @@ TEST_CASE("a System without a depth source of its own tracks built frames, the s
 TEST_CASE("seq 04: each keyframe keeps the motion tracked from the one before, and local BA keeps to it") {
   const auto dir = rgbl::test::kitti_seq04();
   if (!dir) return;
-  const auto sequence = rgbl::open_kitti_odometry(*dir);
-  const rgbl::CameraCalibration calibration = sequence->calibration().camera(0);
-  const rgbl::SystemOptions options;
-  rgbl::FrameBuilder builder = lidar_frame_builder(calibration, options);
-  rgbl::System system(options, calibration);
-  for (std::size_t i = 0; i < 30; ++i) {
-    const rgbl::FrameInput input = sequence->load(i);  // the frame views its images
-    rgbl::SensorFrame frame = rgbl::test::sensor_frame(input, 0);
-    frame.index = i;
-    REQUIRE(rgbl::has_pose(system.track(frame, builder.build(frame)).state));
-  }
-  const rgbl::Map& map = system.map();
+  BuiltSeq04 t(*dir);
+  for (std::size_t i = 0; i < 30; ++i) REQUIRE(rgbl::has_pose(t.track(t.load(i)).state));
+  const rgbl::Map& map = t.system.map();
   int paired = 0;
   for (const rgbl::KeyframeId id : map.keyframe_ids()) {
     const rgbl::Keyframe& kf = *map.keyframe(id);
