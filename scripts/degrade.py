@@ -9,8 +9,11 @@ image_00/data, image_01/data) degraded, everything else (scans, calibration, tim
 linked, so rgbl reads DEST exactly as it reads SOURCE. The LiDAR and the ground truth stay real.
 
 --blur K   motion blur of a forward-driving camera: each pixel is averaged along the ray from the
-           principal point over K per mille of its distance to it (K = 25: 15 px at the image's side
-           edges, 0 straight ahead), as a longer exposure at speed smears what passes close by.
+           principal point over K per mille of its distance to it, centred on the pixel (K = 25: 15 px
+           at the image's side edges, 0 straight ahead), as a longer exposure at speed smears what
+           passes close by. Centred, as an exposure centred on the frame's time (the simulator's):
+           averaged only inwards, the image would also be magnified by K/2 per mille, a focal-length
+           error that is not blur.
 --gain G   exposure jumps: each frame's intensity scaled by a factor drawn uniformly from [1-G, 1+G]
            (seeded), with a gamma drawn from [1-G/2, 1+G/2]: auto-exposure hunting under trees.
 
@@ -33,7 +36,7 @@ def radial_blur(image, principal, strength, samples=16):
     dx, dy = xs - principal[0], ys - principal[1]
     acc = np.zeros((h, w), np.float32)
     for i in range(samples):
-        s = 1.0 - strength * i / (samples - 1)
+        s = 1.0 + strength * (0.5 - i / (samples - 1))  # 1 + K/2 .. 1 - K/2: no magnification
         acc += cv2.remap(image, principal[0] + dx * s, principal[1] + dy * s, cv2.INTER_LINEAR,
                          borderMode=cv2.BORDER_REFLECT)
     return acc / samples
