@@ -54,8 +54,8 @@ int main(int argc, char** argv) {
       }
       for (const auto& k : keypoints) {
         const cv::Mat& level = smoothed[static_cast<std::size_t>(k.level)];
-        const float scale = extractor.level_scales()[static_cast<std::size_t>(k.level)];
-        const int cx = round_to_int(k.x / scale), cy = round_to_int(k.y / scale);
+        const rgbl::LevelMap& m = extractor.level_maps()[static_cast<std::size_t>(k.level)];
+        const int cx = round_to_int(m.level_x(k.x)), cy = round_to_int(m.level_y(k.y));
         const float a = k.angle * 3.14159265358979323846F / 180.0F;
         const float ca = std::cos(a), sa = std::sin(a);
         const std::size_t word = patches / 64, bit = patches % 64;

@@ -199,8 +199,19 @@ OrbExtractor::OrbExtractor(const OrbOptions& options) : options_(options) {
   pyramid_.resize(static_cast<std::size_t>(levels));
 }
 
+LevelMap LevelMap::between(cv::Size level0, cv::Size level) noexcept {
+  LevelMap m;
+  if (level.width <= 0 || level.height <= 0 || level == level0) return m;
+  m.ax = static_cast<float>(level0.width) / static_cast<float>(level.width);
+  m.ay = static_cast<float>(level0.height) / static_cast<float>(level.height);
+  m.bx = 0.5F * m.ax - 0.5F;
+  m.by = 0.5F * m.ay - 0.5F;
+  return m;
+}
+
 void OrbExtractor::build_pyramid(const cv::Mat& gray) {
   pyramid_[0] = gray;
+  level_maps_.assign(static_cast<std::size_t>(options_.num_levels), LevelMap{});
   for (int l = 1; l < options_.num_levels; ++l) {
     const float s = scales_[static_cast<std::size_t>(l)];
     const cv::Size size(static_cast<int>(std::lround(static_cast<float>(gray.cols) / s)),
@@ -213,6 +224,7 @@ void OrbExtractor::build_pyramid(const cv::Mat& gray) {
     if (dst.size() != size || dst.type() != CV_8UC1 || dst.data == gray.data) dst.create(size, CV_8UC1);
     // Resizing the previous level is cheaper than resizing level 0 and is what ORB-SLAM does.
     cv::resize(pyramid_[static_cast<std::size_t>(l) - 1], dst, size, 0, 0, cv::INTER_LINEAR);
+    level_maps_[static_cast<std::size_t>(l)] = LevelMap::between(gray.size(), size);
   }
 }
 
@@ -449,6 +461,7 @@ void OrbExtractor::describe_level(int level) {
   const cv::Mat& img = pyramid_[static_cast<std::size_t>(level)];
   detail::smooth_for_brief(img, blurred, options_.blur_size, options_.blur_sigma, lv.smooth_row, lv.smooth_rows);
   const float scale = scales_[static_cast<std::size_t>(level)];
+  const LevelMap& to_image = level_maps_[static_cast<std::size_t>(level)];
   const int r = options_.orientation_radius;
   const auto step = static_cast<int>(img.step1());
   const auto blurred_step = static_cast<int>(blurred.step1());
@@ -490,8 +503,8 @@ void OrbExtractor::describe_level(int level) {
     Descriptor d{};
     detail::brief_bits(blurred.ptr<std::uint8_t>(cy) + cx, offsets, d.data());
     Keypoint k;
-    k.x = c.x * scale;
-    k.y = c.y * scale;
+    k.x = to_image.image_x(c.x);
+    k.y = to_image.image_y(c.y);
     k.angle = angle;
     k.response = c.response;
     k.size = static_cast<float>(options_.patch_size) * scale;

@@ -267,8 +267,10 @@ TEST_CASE("ORB: exact feature count, levels, borders and budgets on a real frame
     const float s = extractor.level_scales()[static_cast<std::size_t>(k.level)];
     // Level pixels are integers >= 19 px from the level's border.
     const auto& level_img = extractor.pyramid()[static_cast<std::size_t>(k.level)];
-    const float lx = k.x / s, ly = k.y / s;
+    const rgbl::LevelMap& m = extractor.level_maps()[static_cast<std::size_t>(k.level)];
+    const float lx = m.level_x(k.x), ly = m.level_y(k.y);
     CHECK(std::abs(lx - std::round(lx)) < 1e-3F);
+    CHECK(std::abs(ly - std::round(ly)) < 1e-3F);
     CHECK(lx >= 19.0F);
     CHECK(ly >= 19.0F);
     CHECK(lx < static_cast<float>(level_img.cols - 19));
@@ -287,8 +289,8 @@ TEST_CASE("ORB: orientation is the intensity centroid angle over the radius-15 d
   for (std::size_t i = 0; i < kps.size(); i += 7) {
     const auto& k = kps[i];
     const cv::Mat& level = extractor.pyramid()[static_cast<std::size_t>(k.level)];
-    const float s = extractor.level_scales()[static_cast<std::size_t>(k.level)];
-    const int cx = static_cast<int>(std::lround(k.x / s)), cy = static_cast<int>(std::lround(k.y / s));
+    const rgbl::LevelMap& m = extractor.level_maps()[static_cast<std::size_t>(k.level)];
+    const int cx = static_cast<int>(std::lround(m.level_x(k.x))), cy = static_cast<int>(std::lround(m.level_y(k.y)));
     double m10 = 0, m01 = 0;
     for (int v = -15; v <= 15; ++v) {
       const int w = static_cast<int>(std::floor(std::sqrt(225.0 - v * v) + 0.5));
@@ -325,8 +327,8 @@ TEST_CASE("ORB: every descriptor bit is its rotated BRIEF test on the blurred le
   std::size_t differing_bits = 0;
   for (std::size_t i = 0; i < kps.size(); ++i) {
     const auto& k = kps[i];
-    const float s = extractor.level_scales()[static_cast<std::size_t>(k.level)];
-    const int cx = static_cast<int>(std::lround(k.x / s)), cy = static_cast<int>(std::lround(k.y / s));
+    const rgbl::LevelMap& m = extractor.level_maps()[static_cast<std::size_t>(k.level)];
+    const int cx = static_cast<int>(std::lround(m.level_x(k.x))), cy = static_cast<int>(std::lround(m.level_y(k.y)));
     const float rad = k.angle * (3.14159265358979323846F / 180.0F);
     const float ca = std::cos(rad), sa = std::sin(rad);
     const cv::Mat& b = blurred[static_cast<std::size_t>(k.level)];
@@ -540,6 +542,52 @@ TEST_CASE("ORB: scale invariance on a real frame (1.2x and 1.44x)", "[features][
     INFO("scale " << s << ": match rate " << r.match_rate << ", median rotation " << r.median_rotation);
     CHECK(r.match_rate > (s < 1.3 ? 0.5 : 0.38));  // 0.66 and 0.51 when written
     CHECK(r.median_rotation == Approx(0.0).margin(2.0));
+  }
+}
+
+TEST_CASE("ORB: each level's pixels map to level 0 where cv::resize took them from", "[features][orb]") {
+  // A ramp whose value is the column (the row), resized level by level to the extractor's level
+  // sizes in floats: linear interpolation of a linear ramp is exact, so each level's pixel shows the
+  // level-0 coordinate it came from, and the level map must give it. x * scale^l, ORB-SLAM's map,
+  // is off by 0.5 (scale^l - 1) and more where the sizes were rounded.
+  const int width = 250, height = 200;
+  cv::Mat image(height, width, CV_8UC1, cv::Scalar(0));
+  cv::randu(image, 0, 255);
+  rgbl::OrbOptions options;
+  options.num_features = 100;
+  rgbl::OrbExtractor extractor(options);
+  std::vector<rgbl::Keypoint> kps;
+  std::vector<rgbl::Descriptor> desc;
+  extractor.extract(image, kps, desc);
+  REQUIRE(extractor.level_maps().size() == 8);
+  CHECK(extractor.level_maps()[0].image_x(12.0F) == 12.0F);
+  for (int axis = 0; axis < 2; ++axis) {
+    cv::Mat ramp(height, width, CV_32FC1);
+    for (int v = 0; v < height; ++v)
+      for (int u = 0; u < width; ++u) ramp.at<float>(v, u) = static_cast<float>(axis == 0 ? u : v);
+    for (std::size_t l = 1; l < 8; ++l) {
+      const cv::Mat& level = extractor.pyramid()[l];
+      cv::Mat next;
+      cv::resize(ramp, next, level.size(), 0, 0, cv::INTER_LINEAR);  // from the previous level, as the extractor
+      ramp = next;
+      const rgbl::LevelMap& m = extractor.level_maps()[l];
+      const float s = extractor.level_scales()[l];
+      double worst = 0.0, nominal_worst = 0.0;
+      // away from the borders, where the interpolation clamps
+      for (int v = 2; v < ramp.rows - 2; ++v)
+        for (int u = 2; u < ramp.cols - 2; ++u) {
+          const double seen = ramp.at<float>(v, u);
+          const double mapped = axis == 0 ? m.image_x(static_cast<float>(u)) : m.image_y(static_cast<float>(v));
+          const double nominal = static_cast<double>(axis == 0 ? u : v) * s;
+          worst = std::max(worst, std::abs(mapped - seen));
+          nominal_worst = std::max(nominal_worst, std::abs(nominal - seen));
+        }
+      INFO("axis " << axis << " level " << l);
+      CHECK(worst < 1e-3);
+      if (l >= 4) CHECK(nominal_worst > 0.5);
+      CHECK(m.level_x(m.image_x(17.0F)) == Approx(17.0F));
+      CHECK(m.level_y(m.image_y(17.0F)) == Approx(17.0F));
+    }
   }
 }
 

@@ -260,8 +260,9 @@ TEST_CASE("loop closer: a street of identical blocks verifies false loops, and n
   // and the bag of words, 9 verified, all
   // refused: each would have moved the map 100, 200 or 300 m after as many metres driven; 2026-11-28:
   // 93 candidates, 10 verified, all refused; with keyframes when the established landmarks thin out:
-  // 84 candidates, 12 verified, all refused)
-  CHECK(s.verified >= 5);
+  // 84 candidates, 12 verified, all refused; since keypoints map pixel centre to pixel centre across
+  // pyramid levels: 29 candidates, 3 verified, all refused; without the bound one is still closed, below)
+  CHECK(s.verified >= 1);
   CHECK(s.implausible == s.verified);
   CHECK(s.consistent == 0);
   CHECK(s.closures == 0);

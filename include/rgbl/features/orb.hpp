@@ -65,6 +65,21 @@ std::vector<BriefPair> make_brief_candidates(int patch_size, int count);
 // real patches, the ORB paper's criterion); for other sizes the first 256 candidates.
 std::vector<BriefPair> make_brief_pattern(int patch_size);
 
+// Where a pyramid level's pixel lies in level 0. cv::resize aligns pixel centres and each level's size
+// is rounded, so level x maps to (x + 0.5) * W0 / Wl - 0.5 (y likewise with the heights), not to
+// x * scale_factor^l, which is off by up to 1.6 px, mostly up and left, by an amount that changes as
+// a point moves through the levels (docs/features.md, "Keypoint coordinates across levels").
+struct LevelMap {
+  float ax = 1.0F, bx = 0.0F, ay = 1.0F, by = 0.0F;  // level 0 = a * level + b, per axis
+
+  // level 0's size and the level's (as cv::resize made it)
+  static LevelMap between(cv::Size level0, cv::Size level) noexcept;
+  float image_x(float x) const noexcept { return ax * x + bx; }
+  float image_y(float y) const noexcept { return ay * y + by; }
+  float level_x(float x0) const noexcept { return (x0 - bx) / ax; }
+  float level_y(float y0) const noexcept { return (y0 - by) / ay; }
+};
+
 // Owns the pyramid and scratch buffers, so reusing one extractor across frames allocates nothing in
 // steady state. Not thread-safe: one extractor per thread. Move-only, because copies of its cv::Mat
 // scratch would share pixel buffers (and race when used from two threads).
@@ -85,8 +100,10 @@ class OrbExtractor {
                TaskPool* pool = nullptr);
 
   const OrbOptions& options() const noexcept { return options_; }
-  // scale_factor^level for every level: multiply a level's pixel coordinates by it to get level 0.
+  // scale_factor^level for every level: the nominal scale (keypoint size, search radii, sigmas).
   std::span<const float> level_scales() const noexcept { return scales_; }
+  // Each level's pixels in level 0's, for the pyramid of the last extract() call.
+  std::span<const LevelMap> level_maps() const noexcept { return level_maps_; }
   // Features each level aims for (the geometric series; a level's shortfall moves to the next).
   std::span<const int> level_budgets() const noexcept { return budgets_; }
   // The pyramid of the last extract() call (level 0 shares the input's data).
@@ -130,6 +147,7 @@ class OrbExtractor {
 
   OrbOptions options_;
   std::vector<float> scales_;
+  std::vector<LevelMap> level_maps_;
   std::vector<int> budgets_;
   // The BRIEF pairs as four coordinate arrays (x1..., y1..., x2..., y2...), for rotating several at a time.
   std::vector<float> pattern_soa_;
