@@ -102,8 +102,9 @@ TEST_CASE("loop closer: a revisit of real keyframes with drift is closed and cor
   // closed once, on the first revisit: the keyframes before it are 30 frames down the road and do not
   // see the place, so the original's covisible keyframes confirm it (the next two revisits then
   // agree with the corrected map and only confirm it; since keypoints map pixel centre to pixel
-  // centre across pyramid levels, revisit 1's two verified places disagree with each other and it
-  // confirms nothing, 2026-11-28: a loop left unconfirmed, never a wrong correction)
+  // centre across pyramid levels, revisit 1 verifies 2 places but its loop does not pass the
+  // consistency check, so it confirms nothing, 2026-11-28: a loop left unconfirmed, never a wrong
+  // correction)
   REQUIRE(closures == 1);
   CHECK(closure->current == revisits[0]);
   CHECK(closure->matched == originals[0]);

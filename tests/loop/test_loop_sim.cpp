@@ -3,11 +3,11 @@
 // on a street of identical blocks, built to fool it, no loop may be closed.
 
 #include "rgbl/eval/trajectory_metrics.hpp"
-#include "rgbl/geometry/se3.hpp"
 #include "rgbl/sim/scenarios.hpp"
 #include "rgbl/sim/synthetic.hpp"
 #include "mapped_drive.hpp"
 #include "sim_frames.hpp"
+#include "support/pose_error.hpp"
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
@@ -16,7 +16,6 @@
 #include <cstdint>
 #include <numbers>
 #include <optional>
-#include <utility>
 #include <vector>
 
 namespace {
@@ -101,13 +100,6 @@ Run track(const Lap& lap, bool loop_closing) {
   return track(lap, options);
 }
 
-// How far the written relative pose between two frames is from the truth's (m, deg).
-std::pair<double, double> relative_error(const Eigen::Isometry3d& truth_a, const Eigen::Isometry3d& truth_b,
-                                         const Eigen::Isometry3d& estimate_a, const Eigen::Isometry3d& estimate_b) {
-  const Eigen::Isometry3d E = (truth_a.inverse() * truth_b).inverse() * (estimate_a.inverse() * estimate_b);
-  return {E.translation().norm(), rgbl::rotation_angle(E.linear()) * 180.0 / std::numbers::pi};
-}
-
 // Every frame tracked ok and every closure true: the relative pose between its two frames in the
 // written trajectory agrees with the truth's, whichever distance apart they are (a false closure ties
 // two places tens of metres apart together), and none before frame `first` (where the drive first
@@ -121,7 +113,7 @@ int check_closures(const Lap& lap, const Run& run, std::size_t first) {
     const auto& c = *r.loop_closure;
     const std::size_t i = c.frame_index, j = c.matched_frame_index;
     const double apart = (lap.truth[i].translation() - lap.truth[j].translation()).norm();
-    const auto [error_m, error_deg] = relative_error(lap.truth[i], lap.truth[j], run.estimate[i], run.estimate[j]);
+    const auto [error_m, error_deg] = rgbl::test::relative_error(lap.truth[i], lap.truth[j], run.estimate[i], run.estimate[j]);
     CAPTURE(i, j, apart, error_m, error_deg, c.correction_m, c.correction_deg);
     fmt::print("closure: frame {} with {}, {:.1f} m apart in the truth, relative pose off by {:.3f} m / {:.2f} deg\n",
                i, j, apart, error_m, error_deg);
@@ -316,7 +308,7 @@ TEST_CASE("map merging: a jump on the first lap starts a new map, which the seco
     const std::size_t a = r.loop_closure->frame_index, b = r.loop_closure->matched_frame_index;
     REQUIRE(a < fed.size());
     REQUIRE(b < fed.size());
-    const auto [error_m, error_deg] = relative_error(lap.truth[fed[a]], lap.truth[fed[b]], merged.estimate[a], merged.estimate[b]);
+    const auto [error_m, error_deg] = rgbl::test::relative_error(lap.truth[fed[a]], lap.truth[fed[b]], merged.estimate[a], merged.estimate[b]);
     CAPTURE(fed[a], fed[b], error_m, error_deg);
     fmt::print("merge: frame {} with {}, {:.1f} m apart in the truth, relative pose off by {:.3f} m / {:.2f} deg\n",
                fed[a], fed[b], (lap.truth[fed[a]].translation() - lap.truth[fed[b]].translation()).norm(), error_m,

@@ -3,20 +3,19 @@
 #include "reliability/failure_run.hpp"
 #include "tracking/kitti_run.hpp"
 #include "support/data.hpp"
+#include "support/pose_error.hpp"
 #include "support/sensor_frame.hpp"
 #include "support/thread_counts.hpp"
 #include "loop/mapped_drive.hpp"
 #include "loop/sim_frames.hpp"
 
 #include "rgbl/eval/trajectory_metrics.hpp"
-#include "rgbl/geometry/se3.hpp"
 #include "rgbl/place/place_recognition.hpp"
 
 #include <catch2/catch.hpp>
 
 #include <functional>
 #include <memory>
-#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -107,11 +106,10 @@ TEST_CASE("threaded loop closing: the two laps are closed in the loop thread and
     // a true closure, however far apart its frames (22.6 m measured 2026-11-28): their relative pose
     // in the written trajectory agrees with the truth's, where a false one ties two places together
     const std::size_t i = c.frame_index, j = c.matched_frame_index;
-    const Eigen::Isometry3d E =
-        (truth[i].inverse() * truth[j]).inverse() * (estimate[i].inverse() * estimate[j]);
-    CAPTURE(i, j, (truth[i].translation() - truth[j].translation()).norm());
-    CHECK(E.translation().norm() < 0.3);
-    CHECK(rgbl::rotation_angle(E.linear()) * 180.0 / std::numbers::pi < 1.5);
+    const auto [error_m, error_deg] = rgbl::test::relative_error(truth[i], truth[j], estimate[i], estimate[j]);
+    CAPTURE(i, j, (truth[i].translation() - truth[j].translation()).norm(), error_m, error_deg);
+    CHECK(error_m < 0.3);
+    CHECK(error_deg < 1.5);
   }
   CHECK(ate < 0.3);
 }
