@@ -1,25 +1,25 @@
 #!/usr/bin/env python3
 """Whose scale is off: the run's path length against the truth's and against the LiDAR's own.
 
-  scripts/scan_icp_scale.py DRIVE RUN [FRAMES]
+  PYTHONPATH=build/release/python scripts/scan_icp_scale.py DRIVE RUN [FRAMES]
 
-DRIVE is a KITTI raw drive folder (velodyne_points/data) or an odometry sequence folder (velodyne);
-RUN an `rgbl run --out` folder of it (trajectory_kitti.txt, ground_truth_kitti.txt). Consecutive
+DRIVE is anything `rgbl run` reads with a LiDAR (opened through the rgbl module); RUN an `rgbl run --out` folder of it (trajectory_kitti.txt, ground_truth_kitti.txt). Consecutive
 scans are registered point to plane (3-40 m, 0.25 m voxels, normals from 10 neighbours, Cauchy
 weights), started from the truth's step length straight ahead, so the LiDAR measures each step
 without the camera, the calibration or the tracker. Prints the summed step lengths of the truth, the
-run and the registration, and their ratios. Needs python3-numpy and python3-scipy.
+run and the registration, and their ratios. Needs the Python module (build/release/python),
+python3-numpy and python3-scipy.
 """
-import glob
 import os
 import sys
 
 import numpy as np
+import rgbl
 from scipy.spatial import cKDTree
 
 
-def load_scan(path):
-    p = np.fromfile(path, np.float32).reshape(-1, 4)[:, :3].astype(np.float64)
+def thin(scan):
+    p = scan[:, :3].astype(np.float64)
     r = np.linalg.norm(p, axis=1)
     p = p[(r > 3) & (r < 40)]
     _, keep = np.unique(np.floor(p / 0.25).astype(np.int64), axis=0, return_index=True)
@@ -58,12 +58,15 @@ def register(src, dst, T):
 def main(argv):
     if len(argv) < 3:
         sys.exit(__doc__)
-    drive, run = argv[1], argv[2]
-    scans = sorted(glob.glob(os.path.join(drive, 'velodyne_points', 'data', '*.bin'))) or \
-        sorted(glob.glob(os.path.join(drive, 'velodyne', '*.bin')))
+    sequence = rgbl.open_sequence(argv[1], cameras=[False] * 4, depth=False)
+    run = argv[2]
     gt = np.loadtxt(os.path.join(run, 'ground_truth_kitti.txt')).reshape(-1, 3, 4)
     est = np.loadtxt(os.path.join(run, 'trajectory_kitti.txt')).reshape(-1, 3, 4)
-    frames = min(len(gt), len(est), len(scans), int(argv[3]) + 1 if len(argv) > 3 else 10 ** 9)
+    frames = min(len(gt), len(est), len(sequence), int(argv[3]) + 1 if len(argv) > 3 else 10 ** 9)
+
+    def scan(k):
+        return thin(sequence.load(k, cameras=[False] * 4, depth=False).scan)
+
 
     def step(poses, k):
         A, B = np.eye(4), np.eye(4)
@@ -71,9 +74,9 @@ def main(argv):
         return np.linalg.norm((np.linalg.inv(A) @ B)[:3, 3])
 
     truth, tracked, lidar = 0.0, 0.0, 0.0
-    previous = load_scan(scans[0])
+    previous = scan(0)
     for k in range(1, frames):
-        current = load_scan(scans[k])
+        current = scan(k)
         g = step(gt, k)
         T0 = np.eye(4)
         T0[0, 3] = g  # the Velodyne's x points ahead

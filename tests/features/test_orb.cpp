@@ -559,13 +559,14 @@ TEST_CASE("ORB: each level's pixels map to level 0 where cv::resize took them fr
   std::vector<rgbl::Keypoint> kps;
   std::vector<rgbl::Descriptor> desc;
   extractor.extract(image, kps, desc);
-  REQUIRE(extractor.level_maps().size() == 8);
+  const std::size_t levels = extractor.level_maps().size();
+  REQUIRE(levels == static_cast<std::size_t>(options.num_levels));
   CHECK(extractor.level_maps()[0].image_x(12.0F) == 12.0F);
   for (int axis = 0; axis < 2; ++axis) {
     cv::Mat ramp(height, width, CV_32FC1);
     for (int v = 0; v < height; ++v)
       for (int u = 0; u < width; ++u) ramp.at<float>(v, u) = static_cast<float>(axis == 0 ? u : v);
-    for (std::size_t l = 1; l < 8; ++l) {
+    for (std::size_t l = 1; l < levels; ++l) {
       const cv::Mat& level = extractor.pyramid()[l];
       cv::Mat next;
       cv::resize(ramp, next, level.size(), 0, 0, cv::INTER_LINEAR);  // from the previous level, as the extractor
