@@ -204,9 +204,20 @@ TEST_CASE("KITTI 04 at 1.7 Hz: a second rigid motion is another start, and the r
   // Every 6th frame: 7.9 m between frames. The largest depth consensus (20 points) is a 2 m sideways
   // motion; the true one holds 7 points among the matches it leaves out. From the true start the
   // local map re-finds 29 points on the road against 3. Before, all 8 frames were ok with an ATE of 18.3 m
-  // (0.080 m now).
+  // (0.080 m now). Since returns behind foreground edges are dropped (2026-11-28) the second frame also
+  // has a weak depth consensus 2.5 m off, which the LiDAR refutes and the images favour: the frame ends
+  // on the true step but weak, as contradicting evidence must leave it. What the test guards: the true
+  // step, and no frame reported ok on a wrong pose: the wrong starts here are 2-8 m off, the drift at
+  // this rate stays within 1 % of the distance (frame 42: 0.32 m at 57.8 m; 0.27 m before).
   const rgbl::RunResult run = tracks_every_nth_frame(*seq, 6, 8, 0.2);
-  CHECK(run.count(rgbl::TrackState::Ok) == 8);
+  for (std::size_t i = 0; i < run.frames.size(); ++i) {
+    if (run.frames[i].result.state != rgbl::TrackState::Ok) continue;
+    const double error = (run.trajectory.poses[i].translation() - run.ground_truth[i].translation()).norm();
+    const double distance = (run.ground_truth[i].translation() - run.ground_truth[0].translation()).norm();
+    CAPTURE(i, error, distance);
+    CHECK(error < std::max(0.3, 0.01 * distance));
+  }
+  CHECK(run.count(rgbl::TrackState::Ok) >= 7);
 }
 
 TEST_CASE("KITTI 04 at 1.4 Hz: no image start is near the true motion, the LiDAR proposes one") {
@@ -232,6 +243,26 @@ TEST_CASE("KITTI 04 at 1.1 Hz: where the images favour standing still, the LiDAR
   // an ATE of 20.5 m (0.081 m now).
   const rgbl::RunResult run = tracks_every_nth_frame(*seq, 9, 6, 0.3);
   CHECK(run.count(rgbl::TrackState::Lost) == 0);
+}
+
+TEST_CASE("KITTI 04 at 1.2 Hz: after a loss, no relocalisation where the car cannot be") {
+  const auto seq = rgbl::test::kitti_seq04();
+  if (!seq) return;
+  // Every 8th frame: 10.5 m between frames. Frame 40 is lost (11 frame-to-frame inliers). Relocalising
+  // frame 48 against the whole map, PnP places it at frame 32's place, 21.5 m short on the straight
+  // road, and the local map re-finds 89 of 717 points there (12 %, just over the ratio asked). The car
+  // cannot be there: braking at 1 g from 13 m/s still covers 8.5 m in the 1.67 s since frame 32 (the
+  // reach allowed is 16.4 m). Refused, frame 48 starts a new map at the constant-velocity guess. Before,
+  // it was reported ok 21.7 m off (ATE 8.07 m over the tracked frames).
+  const rgbl::RunResult run = every_nth_frame(*seq, 8);
+  REQUIRE(run.frames.size() == 7);
+  for (std::size_t i = 0; i < run.frames.size(); ++i) {
+    if (run.frames[i].result.state != rgbl::TrackState::Ok) continue;
+    const double error = (run.trajectory.poses[i].translation() - run.ground_truth[i].translation()).norm();
+    CAPTURE(i, error);
+    CHECK(error < 1.0);
+  }
+  CHECK_FALSE(run.frames[6].result.relocalised);
 }
 
 TEST_CASE("a corner entered harder than constant velocity expects: the turn is taken on its support") {

@@ -116,8 +116,10 @@ struct TrackerOptions {
   // a step off in rotation alone, with the centre within reach, only when better supported). Else
   // the step is taken with min_jump_inliers (what a relocalisation needs) and reported as a jump,
   // unless the search from the prediction ended beyond a step's reach from it and the LiDAR prefers
-  // the prediction (scan_arbitration: a facade's windows one bay along); otherwise the frame is weak
-  // and placed at the prediction.
+  // the prediction (scan_arbitration: a facade's windows one bay along); otherwise relocalisation is
+  // asked as for a failed frame, and without one that explains more of it the frame is weak and
+  // placed at the prediction. After a loss, a relocalisation is held to the same reach, measured from
+  // the last tracked frame over the time since (Tracker::within_reach).
   bool check_steps = true;
   double step_tolerance = 0.25;            // m
   double step_tolerance_relative = 0.1;

@@ -118,8 +118,9 @@ class Tracker {
   // The LiDAR's own start for `frame` (see TrackerOptions::lidar_start_max_speed) as T_cur_last.
   std::optional<Eigen::Isometry3d> lidar_start(std::optional<LidarView>& cache, const Frame& frame) const;
   // A step beyond a vehicle's reach on weak evidence: the local map searched from the prediction
-  // instead, else the frame placed at the prediction.
-  Hypothesis step_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const;
+  // instead, else relocalisation (unless tried already), else the frame placed at the prediction.
+  Hypothesis step_hypothesis(Hypothesis h, const Prediction& prediction, bool relocalisation_tried,
+                             ViewLog& views) const;
   // Makes the chosen hypothesis the tracker's state (the only place track() changes it).
   void commit(Hypothesis& h, const Prediction& prediction, const FirstHypothesis& first, const ViewLog& views,
               bool mapping_idle, std::size_t keyframes_queued, TrackerOutcome& outcome);
@@ -163,6 +164,8 @@ class Tracker {
   bool relocalise(Frame& frame) const;
   // The local-map search from a relocalised pose re-finds enough of the points it predicts visible.
   bool relocalisation_confirmed(const LocalMapResult& local) const;
+  // After a loss: is a relocalised pose where the vehicle can be since the last tracked frame?
+  bool within_reach(Frame& frame, const Prediction& prediction) const;
   // extra: (keypoint, world point) correspondences that are not landmarks (temporary points).
   int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {}) const;
   bool need_keyframe(const Frame& frame, int inliers, bool mapping_idle) const;
