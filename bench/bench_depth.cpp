@@ -1,5 +1,6 @@
 #include "bench_data.hpp"
 #include "reference/dilation_reference.hpp"
+#include "reference/occlusion_reference.hpp"
 #include "rgbl/depth/completion.hpp"
 #include "rgbl/depth/ip_basic.hpp"
 #include "rgbl/geometry/projection.hpp"
@@ -51,6 +52,28 @@ void dilation_reference(benchmark::State& state) {
   }
 }
 
+// The occlusion filter on KITTI's 1241 px images: 0.3 deg is 4 px.
+void occlusion_rgbl(benchmark::State& state) {
+  const cv::Mat_<float> sparse = sparse_frame();
+  cv::Mat_<float> work(sparse.size());
+  cv::Mat_<float> scratch;
+  for (auto _ : state) {
+    sparse.copyTo(work);
+    benchmark::DoNotOptimize(rgbl::remove_occluded_samples(work, 4, 1.25F, scratch));
+    benchmark::ClobberMemory();
+  }
+}
+
+void occlusion_reference(benchmark::State& state) {
+  const cv::Mat_<float> sparse = sparse_frame();
+  cv::Mat_<float> work(sparse.size());
+  for (auto _ : state) {
+    sparse.copyTo(work);
+    benchmark::DoNotOptimize(rgbl::reference::remove_occluded_samples(work, 4, 1.25F));
+    benchmark::ClobberMemory();
+  }
+}
+
 void keypoint_depth_rgbl(benchmark::State& state) {
   const cv::Mat_<float> sparse = sparse_frame();
   const auto pixels = keypoints(sparse, 2000);
@@ -92,6 +115,8 @@ void ip_basic_fast_rgbl(benchmark::State& state) {
 
 BENCHMARK(dilation_rgbl)->Name("dilation/rgbl")->Unit(benchmark::kMillisecond);
 BENCHMARK(dilation_reference)->Name("dilation/reference")->Unit(benchmark::kMillisecond);
+BENCHMARK(occlusion_rgbl)->Name("occlusion/rgbl")->Unit(benchmark::kMillisecond);
+BENCHMARK(occlusion_reference)->Name("occlusion/reference")->Unit(benchmark::kMillisecond);
 BENCHMARK(keypoint_depth_rgbl)->Name("keypoint_depth/rgbl")->Unit(benchmark::kMillisecond);
 BENCHMARK(keypoint_depth_reference)->Name("keypoint_depth/reference")->Unit(benchmark::kMillisecond);
 BENCHMARK(ip_basic_fast_rgbl)->Name("ip_basic_fast/rgbl")->Unit(benchmark::kMillisecond);

@@ -153,6 +153,9 @@ def dilate_depth(sparse: _Array, kernel: str = "diamond", size: int = 5, max_dep
     """Inverse dilation; kernel 'diamond', 'rectangle' or 'cross' of odd size."""
 def ip_basic(sparse: _Array, mode: str = "fast", max_depth: float = 100.0, extrapolate: bool = False,
              blur: str = "bilateral") -> _F32: ...
+def remove_occluded_samples(sparse: _Array, radius: int, ratio: float = 1.25) -> _F32:
+    """A copy without the samples with one nearer by more than `ratio` within `radius` px."""
+def occlusion_radius_px(fx: float, window_deg: float = 0.3) -> int: ...
 def depth_density(depth: _Array) -> float: ...
 
 class DepthSourceNeeds:

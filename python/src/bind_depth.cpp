@@ -83,6 +83,22 @@ void bind_depth(py::module_& m) {
       py::arg("blur") = "bilateral",
       "IP-Basic depth completion (Ku et al. 2018), 'fast' or 'multiscale'. float32 H x W in and out.");
   m.def(
+      "remove_occluded_samples",
+      [](const ImageArg& sparse, int radius, float ratio) {
+        MatView keep;
+        cv::Mat_<float> out = depth_view(sparse, "sparse", keep).clone();
+        {
+          const py::gil_scoped_release release;
+          remove_occluded_samples(out, radius, ratio);
+        }
+        return mat_array(out);
+      },
+      py::arg("sparse"), py::arg("radius"), py::arg("ratio") = 1.25F,
+      "A copy of the sparse depth without the samples the camera cannot see: those with a sample nearer by "
+      "more than the factor `ratio` within `radius` px (what the lidar source does before completion).");
+  m.def("occlusion_radius_px", &occlusion_radius_px, py::arg("fx"), py::arg("window_deg") = 0.3,
+        "The occlusion filter's half-width in px for a window of window_deg at focal length fx px.");
+  m.def(
       "depth_density", [](const ImageArg& depth) {
         MatView keep;
         return depth_density(depth_view(depth, "depth", keep));

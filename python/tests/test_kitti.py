@@ -39,13 +39,20 @@ def test_lidar_source_is_projection_plus_dilation_on_a_real_scan(seq04):
     sparse = rgbl.project_to_depth(frame.scan, calibration)
     assert sparse.shape == (370, 1226)
     assert 15000 < np.count_nonzero(sparse) < 30000  # ~20k of 124k points fall into the image
-    dense = rgbl.dilate_depth(sparse)
+    # the source drops the samples behind foreground edges in the camera's view (0.3 deg, 25 % nearer)
+    radius = rgbl.occlusion_radius_px(calibration.camera.fx, 0.3)
+    assert radius == 4  # 707 px * tan(0.3 deg) = 3.7 px
+    visible = rgbl.remove_occluded_samples(sparse, radius, 1.25)
+    dropped = np.count_nonzero(sparse) - np.count_nonzero(visible)
+    assert 0 < dropped < 0.1 * np.count_nonzero(sparse)
+    assert np.all((visible == 0) | (visible == sparse))
+    dense = rgbl.dilate_depth(visible)
     assert rgbl.depth_density(dense) > 3 * rgbl.depth_density(sparse)
     source = rgbl.make_depth_source("lidar", calibration)
     source.prepare(frame.images[0], frame.scan)
     assert np.array_equal(source.dense_depth(), dense)
     # keypoints read the same depths as the dense map where they fall on a sample
-    v, u = np.nonzero(sparse)
+    v, u = np.nonzero(visible)
     pixels = np.column_stack([u[:50], v[:50]]).astype(np.float32)
     assert np.all(source.sample(pixels)[:, 0] > 0)
 

@@ -4,9 +4,12 @@
 #include "rgbl/core/error.hpp"
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
+#include <numbers>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -670,6 +673,58 @@ void lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions& options,
   const std::vector<Cell> cells = kernel_cells(kernel);
   const Inversion inv(options.max_depth);
   for (std::size_t i = 0; i < pixels.size(); ++i) out[i] = lookup_one(sparse, cells, kernel.radius(), inv, pixels[i]);
+}
+
+int remove_occluded_samples(cv::Mat_<float>& sparse, int radius, float ratio, cv::Mat_<float>& scratch) {
+  require(radius >= 0, "lidar.occlusion radius", ">= 0 px");
+  require(ratio > 1.0F, "lidar.occlusion_ratio", "> 1");
+  if (radius == 0 || sparse.empty()) return 0;
+  // Only the rows the scan covers (on KITTI the top third of the image has no return) and the window
+  // around them: outside, every pixel is empty either way.
+  int first = sparse.rows, last = -1;
+  for (int y = 0; y < sparse.rows; ++y) {
+    const float* row = sparse[y];
+    if (std::any_of(row, row + sparse.cols, [](float v) { return v > 0.0F; })) {
+      first = std::min(first, y);
+      last = y;
+    }
+  }
+  if (last < 0) return 0;
+  const int top = std::max(0, first - radius), bottom = std::min(sparse.rows, last + radius + 1);
+  // The nearest sample around every pixel: a grey erosion with empty pixels as +infinity. The loops are
+  // branch-free so that they vectorise; the scratch image is reused from frame to frame.
+  const float empty = std::numeric_limits<float>::max();
+  scratch.create(bottom - top, sparse.cols);
+  for (int y = top; y < bottom; ++y) {
+    const float* in = sparse[y];
+    float* out = scratch[y - top];
+    for (int x = 0; x < sparse.cols; ++x) out[x] = in[x] > 0.0F ? in[x] : empty;
+  }
+  cv::erode(scratch, scratch, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * radius + 1, 2 * radius + 1)),
+            cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(empty));
+  int dropped = 0;
+  for (int y = top; y < bottom; ++y) {
+    float* row = sparse[y];
+    const float* nearest = scratch[y - top];
+    for (int x = 0; x < sparse.cols; ++x) {
+      const bool drop = row[x] > ratio * nearest[x];  // false for an empty pixel (0 > a positive depth)
+      dropped += drop ? 1 : 0;
+      row[x] = drop ? 0.0F : row[x];
+    }
+  }
+  return dropped;
+}
+
+int remove_occluded_samples(cv::Mat_<float>& sparse, int radius, float ratio) {
+  cv::Mat_<float> scratch;
+  return remove_occluded_samples(sparse, radius, ratio, scratch);
+}
+
+int occlusion_radius_px(double fx, double window_deg) {
+  require(fx > 0.0, "occlusion_radius_px fx", "> 0 px");
+  require(window_deg >= 0.0 && window_deg < 90.0, "lidar.occlusion_window_deg", "in [0, 90) deg");
+  if (window_deg == 0.0) return 0;
+  return std::max(1, static_cast<int>(std::lround(fx * std::tan(window_deg * std::numbers::pi / 180.0))));
 }
 
 double depth_density(const cv::Mat_<float>& depth) {

@@ -29,6 +29,8 @@ void LidarSourceOptions::validate() const {
   dilation.validate();
   ip_basic.validate();
   require(surface_tolerance >= 0.0F && surface_tolerance < 1.0F, "lidar.surface_tolerance", "a fraction in [0, 1)");
+  require(occlusion_window_deg >= 0.0 && occlusion_window_deg < 5.0, "lidar.occlusion_window_deg", "0 (off) .. 5 deg");
+  require(occlusion_ratio > 1.0F, "lidar.occlusion_ratio", "> 1");
 }
 
 void PrecomputedSourceOptions::validate() const {
@@ -130,6 +132,10 @@ class LidarDepthSource final : public DepthSource {
     // copes with that.
     sparse_.create(camera_.height, camera_.width);
     project_to_depth(frame.scan, P_img_lidar_, options_.projection, sparse_);
+    if (options_.occlusion_window_deg > 0.0) {
+      remove_occluded_samples(sparse_, occlusion_radius_px(camera_.fx, options_.occlusion_window_deg),
+                              options_.occlusion_ratio, occlusion_scratch_);
+    }
     dense_.release();
     if (options_.completion != CompletionMethod::dilation) dense_ = complete();
   }
@@ -169,6 +175,7 @@ class LidarDepthSource final : public DepthSource {
   Matrix34d P_img_lidar_;
   LidarSourceOptions options_;
   cv::Mat_<float> sparse_;
+  cv::Mat_<float> occlusion_scratch_;
   cv::Mat_<float> dense_;  // only for the dense completion methods
 };
 

@@ -1,4 +1,5 @@
 #include "bench/reference/dilation_reference.hpp"
+#include "bench/reference/occlusion_reference.hpp"
 #include "rgbl/core/error.hpp"
 #include "rgbl/depth/completion.hpp"
 #include "rgbl/geometry/calibration.hpp"
@@ -12,6 +13,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <tuple>
 
 namespace {
 
@@ -232,4 +234,65 @@ TEST_CASE("surface-mean keypoint depth removes the minimum's bias on a slanted p
   CHECK_THROWS_AS(rgbl::lookup_surface_depth(edge, {}, 1.5F, std::span<const Eigen::Vector2f>(&on_edge, 1),
                                              std::span<rgbl::KeypointDepth>(&post, 1)),
                   rgbl::ConfigError);
+}
+
+TEST_CASE("samples behind a foreground edge in the camera's view are dropped, a slanted road is kept") {
+  // A post at 10 m in columns 20-22 in front of a wall at 30 m; one wall return has landed on the
+  // post itself (what a LiDAR behind the camera sees past the edge).
+  cv::Mat_<float> sparse(40, 60, 0.0F);
+  for (int v = 0; v < 40; v += 2) {
+    for (int u = 0; u < 60; u += 2) sparse(v, u) = (u >= 20 && u <= 22) ? 10.0F : 30.0F;
+  }
+  sparse(10, 21) = 30.0F;
+  const cv::Mat_<float> before = sparse.clone();
+  const int dropped = rgbl::remove_occluded_samples(sparse, 4, 1.25F);
+  int expected = 0;
+  for (int v = 0; v < 40; ++v) {
+    for (int u = 0; u < 60; ++u) {
+      if (before(v, u) <= 0.0F) continue;
+      // a wall sample within 4 px (a square) of a post sample goes; everything else stays
+      const bool behind = before(v, u) == 30.0F && ((u >= 16 && u <= 26) || (v == 10 && u == 21));
+      expected += behind ? 1 : 0;
+      INFO("pixel " << u << ", " << v);
+      CHECK(sparse(v, u) == (behind ? 0.0F : before(v, u)));
+    }
+  }
+  CHECK(dropped == expected);
+  CHECK(sparse(10, 21) == 0.0F);
+
+  // The road (fx = 350, 1.65 m up, horizon at row 0) changes its depth by 13 % over 4 rows at row 30
+  // (16 m): under the 25 %, nothing goes. Off (radius 0) changes nothing either.
+  cv::Mat_<float> road(90, 40, 0.0F);
+  for (int v = 30; v < 90; ++v) {
+    for (int u = 0; u < 40; ++u) road(v, u) = static_cast<float>(350.0 * 1.65 / v);
+  }
+  CHECK(rgbl::remove_occluded_samples(road, 4, 1.25F) == 0);
+  CHECK(rgbl::remove_occluded_samples(sparse, 0, 1.25F) == 0);
+  CHECK_THROWS_AS(rgbl::remove_occluded_samples(road, 4, 1.0F), rgbl::ConfigError);
+}
+
+TEST_CASE("the occlusion filter equals the straightforward window scan, with one scratch image reused") {
+  // Random sparse images of several sizes, samples only in a band of rows (as a scan's) or touching
+  // the borders, depths spread over 2-60 m so that many samples have a nearer one within the window.
+  std::mt19937 rng(5);
+  cv::Mat_<float> scratch;
+  for (const auto& [rows, cols, top, bottom, radius] :
+       {std::tuple{40, 60, 10, 30, 4}, std::tuple{37, 53, 0, 37, 2}, std::tuple{90, 120, 50, 90, 6},
+        std::tuple{20, 20, 5, 6, 4}, std::tuple{30, 41, 0, 3, 1}}) {
+    cv::Mat_<float> sparse(rows, cols, 0.0F);
+    std::uniform_real_distribution<float> depth(2.0F, 60.0F);
+    std::bernoulli_distribution sample(0.2);
+    for (int v = top; v < bottom; ++v) {
+      for (int u = 0; u < cols; ++u) sparse(v, u) = sample(rng) ? depth(rng) : 0.0F;
+    }
+    cv::Mat_<float> expected = sparse.clone();
+    const int expected_dropped = rgbl::reference::remove_occluded_samples(expected, radius, 1.25F);
+    const int dropped = rgbl::remove_occluded_samples(sparse, radius, 1.25F, scratch);
+    INFO(rows << " x " << cols << ", rows " << top << "-" << bottom << ", radius " << radius);
+    CHECK(expected_dropped > 0);
+    CHECK(dropped == expected_dropped);
+    CHECK(cv::countNonZero(sparse != expected) == 0);
+  }
+  cv::Mat_<float> empty(10, 10, 0.0F);
+  CHECK(rgbl::remove_occluded_samples(empty, 4, 1.25F, scratch) == 0);
 }

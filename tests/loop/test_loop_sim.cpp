@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <numbers>
 #include <optional>
@@ -188,19 +189,27 @@ TEST_CASE("loop closer: a bag of words alone closes the two laps (a depth source
 TEST_CASE("loop closer: a drive that ends where it began is closed at its last keyframe") {
   // one lap of a 79 m loop (`rgbl demo --path loop --frames 80`): only the last keyframes see the
   // first ones' places, the keyframes before them are behind the start, so the matched keyframe's
-  // neighbours confirm the loop
-  const Lap lap = one_lap(1);
-  const Run with = track(lap, true);
-  const Run without = track(lap, false);
-  const int closures = check_closures(lap, with, 70);
-  fmt::print("one lap of a 79 m loop: {} closures, ATE {:.3f} m (without loop closing {:.3f} m)\n", closures, with.ate,
-             without.ate);
-  // measured: 1 closure (frame 77 with frame 0), ATE 0.157 m against 0.303 m; since the road and the
-  // tracked motion tie local BA's keyframes (2026-11-28): 0.037 m against 0.061 m; since keyframes
-  // come when the established landmarks thin out: frame 76 with frame 0, 0.024 m against 0.068 m
-  CHECK(closures == 1);
-  CHECK(with.loops.implausible == 0);
-  CHECK(with.ate < 0.7 * without.ate);
+  // neighbours confirm the loop. Three seeds: one lap's gain is one sample of a chaotic run (seed 1
+  // alone, with/without at 5 feature counts: 0.58-0.90 on main before the occlusion filter).
+  double log_ratio = 0.0;
+  for (const std::uint64_t seed : {1, 2, 3}) {
+    CAPTURE(seed);
+    const Lap lap = one_lap(seed);
+    const Run with = track(lap, true);
+    const Run without = track(lap, false);
+    // seed 3 closes at frame 68, with frame 0's place 10.7 m ahead in view
+    const int closures = check_closures(lap, with, 65);
+    fmt::print("one lap of a 79 m loop, seed {}: {} closures, ATE {:.3f} m (without loop closing {:.3f} m)\n", seed,
+               closures, with.ate, without.ate);
+    CHECK(closures == 1);
+    CHECK(with.loops.implausible == 0);
+    CHECK(with.ate < without.ate);
+    log_ratio += std::log(with.ate / without.ate) / 3.0;
+  }
+  // measured (seeds 1, 2, 3): 0.046 / 0.060, 0.025 / 0.073, 0.034 / 0.056 m, a geometric mean of 0.54
+  // (0.55 before returns behind foreground edges were dropped). Seed 1 alone, since keyframes come when
+  // the established landmarks thin out: 0.024 m against 0.068 m.
+  CHECK(std::exp(log_ratio) < 0.7);
 }
 
 TEST_CASE("loop closer: the global bundle adjustment holds keyframes the shared landmarks cannot place") {

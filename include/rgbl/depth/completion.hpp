@@ -82,6 +82,19 @@ KeypointDepth lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions&
 void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, float surface_tolerance,
                           std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out);
 
+// Drops the samples of `sparse` that the camera cannot see: a sample with a sample nearer by more than
+// the factor `ratio` within `radius` px (a square) lies behind a foreground edge in the camera's view.
+// The LiDAR sees past such edges from where it sits (on KITTI 0.27 m behind and 0.08 m above the
+// camera; a scan that is not motion-compensated adds its own shift), so background returns land a few
+// pixels inside foreground objects, where keypoints concentrate (corners). Returns how many were dropped.
+int remove_occluded_samples(cv::Mat_<float>& sparse, int radius, float ratio);
+// The same with a caller-kept scratch image (no allocation per frame).
+int remove_occluded_samples(cv::Mat_<float>& sparse, int radius, float ratio, cv::Mat_<float>& scratch);
+
+// The half-width in px of a window of `window_deg` seen by a camera of focal length `fx` px (>= 1 for a
+// positive angle, 0 for 0): the occlusion filter's window as an angle means the same at any resolution.
+int occlusion_radius_px(double fx, double window_deg);
+
 // Share of pixels with depth (> 0), in [0, 1].
 double depth_density(const cv::Mat_<float>& depth);
 

@@ -39,6 +39,12 @@ struct LidarSourceOptions {
   IpBasicOptions ip_basic{};
   KeypointDepthRule keypoint_depth = KeypointDepthRule::surface_mean;
   float surface_tolerance = 0.05F;  // relative depth step between neighbouring samples of one surface
+  // Samples behind a foreground edge in the camera's view are dropped before completion
+  // (remove_occluded_samples): those with a sample nearer by occlusion_ratio within occlusion_window_deg
+  // (as an angle, so the same at any resolution: 4 px on KITTI's 1241 px images). A road changes its
+  // depth by less than that across the window up to ~70 m away. 0 turns the filter off.
+  double occlusion_window_deg = 0.3;
+  float occlusion_ratio = 1.25F;
 
   void validate() const;
 };
