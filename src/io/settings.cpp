@@ -342,6 +342,14 @@ Settings read_settings(const std::filesystem::path& yaml) {
     if (*v < 1 || *v % 2 == 0) r.fail("LiDAR.MethodInverseDilation.KernelSize_u", "an odd kernel size >= 1");
     s.kernel_size = *v;
   }
+  if (const auto v = r.number({"LiDAR.OcclusionWindowDeg"})) {
+    if (!(*v >= 0.0 && *v < 5.0)) r.fail("LiDAR.OcclusionWindowDeg", "0 (off) .. 5 deg");
+    s.occlusion_window_deg = *v;
+  }
+  if (const auto v = r.number({"LiDAR.OcclusionRatio"})) {
+    if (!(*v > 1.0)) r.fail("LiDAR.OcclusionRatio", "a depth ratio > 1");
+    s.occlusion_ratio = *v;
+  }
 
   const auto flag = [&](std::string_view key) -> std::optional<bool> {
     const auto v = r.integer({key});

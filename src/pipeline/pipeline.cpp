@@ -51,6 +51,8 @@ void apply_settings(const Settings& s, Resolved p) {
     p.lidar.dilation.shape = parse_kernel_shape(shape, "LiDAR.MethodInverseDilation.KernelType");
   }
   if (s.kernel_size > 0) p.lidar.dilation.size = s.kernel_size;
+  if (s.occlusion_window_deg) p.lidar.occlusion_window_deg = *s.occlusion_window_deg;
+  if (s.occlusion_ratio) p.lidar.occlusion_ratio = static_cast<float>(*s.occlusion_ratio);
   if (s.T_cam_lidar) {
     p.calibration.T_cam_lidar = *s.T_cam_lidar;
     p.notes.push_back(fmt::format("{}: LiDAR.Tr overrides the dataset's LiDAR extrinsics", s.file.string()));

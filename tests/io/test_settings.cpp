@@ -171,6 +171,22 @@ TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
              Contains("LoopClosing.GlobalBA"));
 }
 
+TEST_CASE("settings: rgbl's LiDAR occlusion keys", "[io][settings]") {
+  rgbl::test::TempDir tmp;
+  const auto s = rgbl::read_settings(
+      tmp.write("occ.yaml", "%YAML:1.0\nLiDAR.OcclusionWindowDeg: 0\nLiDAR.OcclusionRatio: 1.5\n"));
+  CHECK(s.occlusion_window_deg == 0.0);
+  CHECK(s.occlusion_ratio == 1.5);
+  CHECK(s.warnings.empty());
+  const auto unset = rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n"));
+  CHECK_FALSE(unset.occlusion_window_deg);
+  CHECK_FALSE(unset.occlusion_ratio);
+  CHECK_THAT(error_of(tmp.write("w.yaml", "%YAML:1.0\nLiDAR.OcclusionWindowDeg: -0.1\n")),
+             Contains("'LiDAR.OcclusionWindowDeg': expected 0 (off) .. 5 deg"));
+  CHECK_THAT(error_of(tmp.write("r.yaml", "%YAML:1.0\nLiDAR.OcclusionRatio: 1\n")),
+             Contains("'LiDAR.OcclusionRatio': expected a depth ratio > 1"));
+}
+
 TEST_CASE("settings: LocalMapping.PlaceCulling switches keyframe culling by revisits", "[io][settings]") {
   rgbl::test::TempDir tmp;
   const auto off = rgbl::read_settings(tmp.write("off.yaml", "%YAML:1.0\nLocalMapping.PlaceCulling: 0\n"));

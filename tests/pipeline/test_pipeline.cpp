@@ -126,6 +126,17 @@ TEST_CASE("a sequence described as `rgbl info` prints it: its frames, sensors an
   CHECK_THAT(text, Catch::Contains(fmt::format("ground truth:  {} poses", seq->size())));
 }
 
+TEST_CASE("the settings file's LiDAR occlusion keys reach the LiDAR source") {
+  rgbl::test::TempDir dir;
+  dir.write("occ.yaml", "%YAML:1.0\nLiDAR.OcclusionWindowDeg: 0\nLiDAR.OcclusionRatio: 1.5\n");
+  auto o = options();
+  CHECK(rgbl::Pipeline(o).lidar_options().occlusion_window_deg == rgbl::LidarSourceOptions{}.occlusion_window_deg);
+  o.settings = dir.path() / "occ.yaml";
+  const rgbl::Pipeline pipeline(o);
+  CHECK(pipeline.lidar_options().occlusion_window_deg == 0.0);
+  CHECK(pipeline.lidar_options().occlusion_ratio == 1.5F);
+}
+
 TEST_CASE("a run that tracks nothing says so in its metrics: no figure for tracked frames") {
   // 100 features leave fewer keypoints with depth than initialisation needs: no frame is tracked
   rgbl::test::TempDir dir;

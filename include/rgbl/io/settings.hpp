@@ -9,6 +9,7 @@
 //   ORBextractor.nFeatures scaleFactor nLevels iniThFAST minThFAST,
 //   LiDAR.Method, LiDAR.min_dist, LiDAR.max_dist, LiDAR.Tr11 .. LiDAR.Tr34 (T_cam_lidar, row-major),
 //   LiDAR.MethodInverseDilation.KernelType, LiDAR.MethodInverseDilation.KernelSize_u,
+//   rgbl's own LiDAR.OcclusionWindowDeg (0 = off), LiDAR.OcclusionRatio (LidarSourceOptions::occlusion_*),
 //   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
 //   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1), MergeMaps (0/1) (LoopClosingOptions' fields of those
 //   names).
@@ -70,6 +71,8 @@ struct Settings {
   std::optional<Eigen::Isometry3d> T_cam_lidar;
   std::string kernel_type;            // e.g. "Diamond"; empty when absent
   int kernel_size = 0;                // 0 when absent
+  std::optional<double> occlusion_window_deg;  // LiDAR.OcclusionWindowDeg; unset = the source's default
+  std::optional<double> occlusion_ratio;       // LiDAR.OcclusionRatio; unset = the source's default
   LoopClosingSettings loop_closing;
   std::optional<bool> place_culling;  // LocalMapping.PlaceCulling: keyframe culling by revisits
   std::vector<std::string> warnings;  // unknown keys, one message each
