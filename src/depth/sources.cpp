@@ -122,6 +122,7 @@ class LidarDepthSource final : public DepthSource {
   LidarDepthSource(const LidarSourceOptions& options, const DepthSourceContext& context)
       : camera_(context.calibration.camera), P_img_lidar_(context.calibration.P_img_lidar()), options_(options) {
     options_.validate();
+    occlusion_radius_ = occlusion_radius_px(camera_.fx, options_.occlusion_window_deg);  // 0: off
   }
 
   std::string_view name() const override { return "lidar"; }
@@ -132,10 +133,7 @@ class LidarDepthSource final : public DepthSource {
     // copes with that.
     sparse_.create(camera_.height, camera_.width);
     project_to_depth(frame.scan, P_img_lidar_, options_.projection, sparse_);
-    if (options_.occlusion_window_deg > 0.0) {
-      remove_occluded_samples(sparse_, occlusion_radius_px(camera_.fx, options_.occlusion_window_deg),
-                              options_.occlusion_ratio, occlusion_scratch_);
-    }
+    remove_occluded_samples(sparse_, occlusion_radius_, options_.occlusion_ratio, occlusion_scratch_);
     dense_.release();
     if (options_.completion != CompletionMethod::dilation) dense_ = complete();
   }
@@ -175,6 +173,7 @@ class LidarDepthSource final : public DepthSource {
   Matrix34d P_img_lidar_;
   LidarSourceOptions options_;
   cv::Mat_<float> sparse_;
+  int occlusion_radius_ = 0;  // px, from occlusion_window_deg once
   cv::Mat_<float> occlusion_scratch_;
   cv::Mat_<float> dense_;  // only for the dense completion methods
 };

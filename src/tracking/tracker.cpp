@@ -170,6 +170,7 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
     }
     if (!ok) {
       ok = h.relocalised = relocalise(frame) && within_reach(frame, prediction);
+      if (!ok) clear_matches(frame);
       // counts even if the local map rejects it below: the next frames need the stricter support
       if (ok) h.relocalisation_frame = frame.index;
     }
@@ -507,7 +508,7 @@ bool Tracker::suspect(int motion_inliers, const LocalMapResult& local) const {
   return map_disagrees || motion_collapsed;
 }
 
-bool Tracker::within_reach(Frame& frame, const Prediction& prediction) const {
+bool Tracker::within_reach(const Frame& frame, const Prediction& prediction) const {
   // The camera cannot be anywhere: from the last tracked pose and velocity, over the time since, it is
   // within the step check's reach of the constant-velocity guess (the allowance grows with the time
   // squared, so after a few seconds anywhere goes). A straight road looks alike along itself: KITTI 04
@@ -523,7 +524,6 @@ bool Tracker::within_reach(Frame& frame, const Prediction& prediction) const {
   logger()->debug("frame {}: relocalisation rejected, {:.2f} m from the constant-velocity guess {:.2f} s after the last "
                   "tracked frame (within reach: {:.2f} m)", frame.index, reach.translation_m, dt,
                   reach.allowed_translation_m);
-  clear_matches(frame);
   return false;
 }
 

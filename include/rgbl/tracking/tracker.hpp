@@ -165,7 +165,7 @@ class Tracker {
   // The local-map search from a relocalised pose re-finds enough of the points it predicts visible.
   bool relocalisation_confirmed(const LocalMapResult& local) const;
   // After a loss: is a relocalised pose where the vehicle can be since the last tracked frame?
-  bool within_reach(Frame& frame, const Prediction& prediction) const;
+  bool within_reach(const Frame& frame, const Prediction& prediction) const;
   // extra: (keypoint, world point) correspondences that are not landmarks (temporary points).
   int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {}) const;
   bool need_keyframe(const Frame& frame, int inliers, bool mapping_idle) const;
