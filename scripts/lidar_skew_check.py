@@ -8,7 +8,7 @@ Stereo is exposed at one instant; a spinning LiDAR that is not compensated measu
 image before the other, so the difference grows linearly with azimuth (slope ~ speed / spin rate).
 With SPIN (+1: clockwise from above, -1) and a ground-truth trajectory (trajectory file of `rgbl run`'s
 ground_truth_kitti.txt) each point is first moved to the camera time with the true velocity, as
-SystemOptions::lidar_scan_period does in the tracker: the right sign flattens the trend.
+a motion correction of the sweep would do (docs/accuracy.md, "The LiDAR's sweep"): the right sign flattens the trend.
 """
 import glob
 import sys

@@ -110,6 +110,8 @@ class Frame:
     @property
     def timestamp(self) -> float: ...
     @property
+    def scan_timestamp(self) -> Optional[float]: ...
+    @property
     def images(self) -> list[Optional[_U8]]: ...  # 0/1 grey H x W, 2/3 BGR H x W x 3
     @property
     def scan(self) -> _F32: ...  # N x 4
@@ -327,6 +329,7 @@ class TrackResult:
     inliers: int
     keypoints: int
     keypoints_with_depth: int
+    scan_age: float
     map_keyframes: int
     map_landmarks: int
     loop_closure: Optional[LoopClosure]
@@ -348,7 +351,7 @@ class System:
                  threaded: bool = False, loop_closing: bool = True, stereo_baseline: float = 0.0) -> None: ...
     def track(self, image: _Array, scan: Optional[_Array] = None, *, index: Optional[int] = None,
               timestamp: Optional[float] = None, image_right: Optional[_Array] = None,
-              depth_image: Optional[_Array] = None) -> TrackResult:
+              depth_image: Optional[_Array] = None, scan_timestamp: Optional[float] = None) -> TrackResult:
         """Tracks one frame (arrays read in place, the GIL released while C++ runs)."""
     def finish(self) -> None: ...
     def trajectory(self) -> SystemTrajectory: ...

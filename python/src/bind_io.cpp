@@ -80,6 +80,8 @@ void bind_io(py::module_& m) {
                          "N x 4; depth float32 H x W or None; T_world_cam0 float64 4 x 4 or None.")
       .def_readonly("index", &FrameInput::index)
       .def_readonly("timestamp", &FrameInput::timestamp)
+      .def_readonly("scan_timestamp", &FrameInput::scan_timestamp,
+                    "When the scan faced forward (KITTI raw), on the timestamp's clock; None when not given.")
       .def_property_readonly("images", [](const py::object& self) {
         py::list out;
         for (const cv::Mat& image : self.cast<const FrameInput&>().images) out.append(mat_array(image, self));

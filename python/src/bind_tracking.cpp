@@ -24,7 +24,7 @@ struct SystemTrajectory {
 
 TrackResult track(System& system, const ImageArg& image, const OptionalScanArg& scan, std::optional<std::size_t> index,
                   std::optional<double> timestamp, const OptionalImageArg& image_right, const OptionalImageArg& depth_image,
-                  std::size_t tracked, double frame_period) {
+                  std::optional<double> scan_timestamp, std::size_t tracked, double frame_period) {
   const MatView left = mat_view(image, "image");
   const MatView right = optional_mat_view(image_right, "image_right");
   const MatView depth = optional_mat_view(depth_image, "depth_image");
@@ -36,6 +36,7 @@ TrackResult track(System& system, const ImageArg& image, const OptionalScanArg& 
   frame.image_right = right.mat;
   frame.depth_image = depth.mat;
   frame.scan = points.points;
+  frame.scan_timestamp = scan_timestamp;
   // the views' arrays stay referenced by this frame's Python arguments while the GIL is released
   const py::gil_scoped_release release;
   return system.track(frame);
@@ -100,6 +101,7 @@ void bind_tracking(py::module_& m) {
       .def_readonly("inliers", &TrackResult::inliers, "Local-map inliers (Ok needs 30).")
       .def_readonly("keypoints", &TrackResult::keypoints)
       .def_readonly("keypoints_with_depth", &TrackResult::keypoints_with_depth)
+      .def_readonly("scan_age", &TrackResult::scan_age, "Seconds the LiDAR depth was moved by (image time - scan time).")
       .def_readonly("map_keyframes", &TrackResult::map_keyframes, "The map's keyframes after this frame.")
       .def_readonly("map_landmarks", &TrackResult::map_landmarks, "The map's landmarks after this frame.")
       .def_readonly("loop_closure", &TrackResult::loop_closure, "A LoopClosure or None.")
@@ -152,19 +154,22 @@ void bind_tracking(py::module_& m) {
       .def(
           "track",
           [](PySystem& s, const ImageArg& image, const OptionalScanArg& scan, std::optional<std::size_t> index,
-             std::optional<double> timestamp, const OptionalImageArg& image_right, const OptionalImageArg& depth_image) {
-            TrackResult r = track(*s.system, image, scan, index, timestamp, image_right, depth_image, s.tracked,
-                                  s.frame_period);
+             std::optional<double> timestamp, const OptionalImageArg& image_right, const OptionalImageArg& depth_image,
+             std::optional<double> scan_timestamp) {
+            TrackResult r = track(*s.system, image, scan, index, timestamp, image_right, depth_image, scan_timestamp,
+                                  s.tracked, s.frame_period);
             ++s.tracked;
             return r;
           },
           py::arg("image"), py::arg("scan") = py::none(), py::kw_only(), py::arg("index") = py::none(),
           py::arg("timestamp") = py::none(), py::arg("image_right") = py::none(), py::arg("depth_image") = py::none(),
+          py::arg("scan_timestamp") = py::none(),
           "Tracks one frame and returns its TrackResult. image: uint8 H x W grey or H x W x 3 BGR (the tracked "
           "rectified camera); scan: float32 N x 4 LiDAR points (x, y, z, reflectance) in the LiDAR frame; "
           "image_right: the stereo pair's right image; depth_image: float32 metres or uint16. Arrays are read in "
           "place (no copies) and the GIL is released while C++ tracks. index defaults to the frames tracked so "
-          "far, timestamp to index x the frame period (0.1 s). Raises ConfigError when the depth source lacks "
+          "far, timestamp to index x the frame period (0.1 s); scan_timestamp: when the scan faced forward, on the "
+          "timestamp's clock (the LiDAR depth is then moved to the image's time). Raises ConfigError when the depth source lacks "
           "its input (e.g. no right image for stereo).")
       .def("finish", [](PySystem& s) {
         const py::gil_scoped_release release;

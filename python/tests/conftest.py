@@ -32,6 +32,11 @@ def seq04() -> pathlib.Path:
 
 
 @pytest.fixture(scope="session")
+def raw0009() -> pathlib.Path:
+    return find_data("kitti/raw/2011_09_26/2011_09_26_drive_0009_sync")
+
+
+@pytest.fixture(scope="session")
 def street(tmp_path_factory) -> rgbl.KittiLayout:
     """24 frames of a curved street at half KITTI resolution, cameras 0-3, LiDAR, exact poses."""
     root = tmp_path_factory.mktemp("street")

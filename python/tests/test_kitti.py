@@ -62,3 +62,18 @@ def test_ate_of_the_ground_truth_against_itself_is_zero(seq04):
     assert len(truth) == 51
     assert rgbl.absolute_trajectory_error(truth, truth).translation.rmse == pytest.approx(0.0, abs=1e-9)
     assert rgbl.trajectory_distances(truth)[-1] == pytest.approx(69, abs=2)  # the excerpt's ~69 m
+
+
+def test_raw_drive_from_python_with_its_scan_times_is_the_pipelines_run(raw0009):
+    """KITTI raw gives each scan's time: passed to System.track, the LiDAR depth moves as in Pipeline.run()."""
+    pipeline = rgbl.Pipeline(raw0009)
+    system = pipeline.make_system()
+    results = []
+    for i in range(pipeline.frame_count):
+        frame = pipeline.sequence.load(pipeline.frame_index(i))
+        assert 0.0166 < frame.timestamp - frame.scan_timestamp < 0.0171
+        results.append(system.track(frame.images[0], frame.scan, index=frame.index, timestamp=frame.timestamp,
+                                    scan_timestamp=frame.scan_timestamp))
+    assert results[-1].scan_age == pytest.approx(frame.timestamp - frame.scan_timestamp)
+    from_python = pipeline.collect(system, results)
+    assert np.array_equal(from_python.trajectory.poses, pipeline.run().trajectory.poses)

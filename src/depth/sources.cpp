@@ -120,19 +120,29 @@ float nearest_sample_distance(const cv::Mat_<float>& sparse, const Eigen::Vector
 class LidarDepthSource final : public DepthSource {
  public:
   LidarDepthSource(const LidarSourceOptions& options, const DepthSourceContext& context)
-      : camera_(context.calibration.camera), P_img_lidar_(context.calibration.P_img_lidar()), options_(options) {
+      : camera_(context.calibration.camera),
+        T_cam_lidar_(context.calibration.T_cam_lidar),
+        P_img_lidar_(context.calibration.P_img_lidar()),
+        options_(options) {
     options_.validate();
     occlusion_radius_ = occlusion_radius_px(camera_.fx, options_.occlusion_window_deg);  // 0: off
   }
 
   std::string_view name() const override { return "lidar"; }
+  bool measured_at_scan_time() const override { return true; }
 
   void prepare(const SensorFrame& frame) override {
     // An empty scan is a LiDAR dropout, not a misconfiguration (a dataset without scans is refused
     // where the source is chosen): the projection leaves the frame without depth, and the tracker
     // copes with that.
     sparse_.create(camera_.height, camera_.width);
-    project_to_depth(frame.scan, P_img_lidar_, options_.projection, sparse_);
+    Matrix34d P = P_img_lidar_;
+    if (frame.T_image_scan.matrix() != Eigen::Matrix4d::Identity()) {
+      // the scan's points first moved to where they are seen from at the image's time
+      const Eigen::Isometry3d T_lidar_motion = T_cam_lidar_.inverse() * frame.T_image_scan * T_cam_lidar_;
+      P = P_img_lidar_ * T_lidar_motion.matrix();
+    }
+    project_to_depth(frame.scan, P, options_.projection, sparse_);
     remove_occluded_samples(sparse_, occlusion_radius_, options_.occlusion_ratio, occlusion_scratch_);
     dense_.release();
     if (options_.completion != CompletionMethod::dilation) dense_ = complete();
@@ -170,6 +180,7 @@ class LidarDepthSource final : public DepthSource {
   }
 
   PinholeCamera camera_;
+  Eigen::Isometry3d T_cam_lidar_;
   Matrix34d P_img_lidar_;
   LidarSourceOptions options_;
   cv::Mat_<float> sparse_;

@@ -42,6 +42,7 @@ class FileSequence final : public Sequence {
     frame.index = index;
     frame.timestamp = files.timestamp;
     frame.T_world_cam0 = files.T_world_cam0;
+    frame.scan_timestamp = files.scan_timestamp;
     for (std::size_t c = 0; c < 4; ++c) {
       if (!options.cameras[c] || files.images[c].empty()) continue;
       if (table_.grey_from_colour && c == 0) continue;  // converted below

@@ -16,6 +16,7 @@ struct FrameFiles {
   double timestamp = 0.0;
   std::array<std::filesystem::path, 4> images;  // empty path: camera absent
   std::filesystem::path scan;
+  std::optional<double> scan_timestamp;  // when the scan faced forward, on the clock of `timestamp`
   std::filesystem::path depth;
   std::optional<Eigen::Isometry3d> T_world_cam0;
 };

@@ -359,6 +359,21 @@ std::unique_ptr<Sequence> open_kitti_raw(const fs::path& drive_dir, const LoadOp
     }
     if (table.sensors.lidar) f.scan = dir / "velodyne_points" / "data" / fmt::format("{:010}.bin", i);
   }
+  // The cameras fire as the LiDAR faces forward, and their timestamps come later (16.9 ms in drive
+  // 2011_09_26_0009): the LiDAR's own times let the tracker move its depth to the image's time.
+  const auto scan_times_file = dir / "velodyne_points" / "timestamps.txt";
+  if (table.sensors.lidar && scan_times_file != time_source && fs::exists(scan_times_file, ec)) {
+    const auto scan_times = read_raw_timestamps(scan_times_file, false);
+    check_count(scan_times_file, scan_times.size(), count, "timestamps");
+    for (std::size_t i = 0; i < count; ++i) {
+      if (!(std::abs(times[i] - scan_times[i]) <= 1.0)) {
+        throw ParseError(scan_times_file, 0,
+                         fmt::format("frame {}: expected the scan within 1 s of the image ({}), found {:.3f} s apart",
+                                     i, time_source.string(), times[i] - scan_times[i]));
+      }
+      table.frames[i].scan_timestamp = scan_times[i];
+    }
+  }
 
   const auto oxts_dir = dir / "oxts" / "data";
   if (fs::is_directory(oxts_dir, ec)) {

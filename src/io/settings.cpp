@@ -350,6 +350,10 @@ Settings read_settings(const std::filesystem::path& yaml) {
     if (!(*v > 1.0)) r.fail("LiDAR.OcclusionRatio", "a depth ratio > 1");
     s.occlusion_ratio = *v;
   }
+  if (const auto v = r.number({"LiDAR.TimeOffset"})) {
+    if (!(std::abs(*v) <= 1.0)) r.fail("LiDAR.TimeOffset", "seconds from the scan to the image, -1 .. 1");
+    s.scan_time_offset = *v;
+  }
 
   const auto flag = [&](std::string_view key) -> std::optional<bool> {
     const auto v = r.integer({key});

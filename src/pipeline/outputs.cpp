@@ -166,6 +166,8 @@ std::string summary_json(const RunResult& run) {
   j["jump_frames"] = run.frames_where([](const TrackResult& r) { return r.jump; });
   j["rejected_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_rejected; });
   j["min_inliers_ok"] = min_inliers ? Json(*min_inliers) : Json(nullptr);
+  const auto scan_age = run.scan_age_median();
+  j["scan_to_image_ms"] = scan_age ? Json(number(*scan_age * 1000.0)) : Json(nullptr);  // median; 0: simultaneous
   j["keyframes"] = run.keyframe_count();
   j["landmarks"] = run.landmarks.size();
   j["loop_closing"] = run.loop_closing;
@@ -220,6 +222,10 @@ std::string summary_text(const RunResult& run) {
                    "{:.0f} ms (global BA of {} keyframes {:.0f} ms)\n",
                    c.merged ? "maps merged" : "loop closed", c.frame_index, c.matched_frame_index, c.correction_m,
                    c.correction_deg, c.fused_landmarks, c.time_ms, c.global_ba_keyframes, c.global_ba_ms);
+  }
+  if (const auto age = run.scan_age_median(); age && *age != 0.0) {
+    fmt::format_to(out, "  LiDAR depth moved to the images' time: scans {:.1f} ms {} (median)\n", std::abs(*age) * 1000.0,
+                   *age > 0.0 ? "earlier" : "later");
   }
   fmt::format_to(out, "  per frame (median / p95 ms): depth {:.2f} / {:.2f}, extraction {:.2f} / {:.2f}, tracking "
                  "{:.2f} / {:.2f}, mapping {:.2f} / {:.2f}\n",

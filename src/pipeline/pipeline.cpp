@@ -53,6 +53,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.kernel_size > 0) p.lidar.dilation.size = s.kernel_size;
   if (s.occlusion_window_deg) p.lidar.occlusion_window_deg = *s.occlusion_window_deg;
   if (s.occlusion_ratio) p.lidar.occlusion_ratio = static_cast<float>(*s.occlusion_ratio);
+  if (s.scan_time_offset) p.system.scan_time_offset = *s.scan_time_offset;
   if (s.T_cam_lidar) {
     p.calibration.T_cam_lidar = *s.T_cam_lidar;
     p.notes.push_back(fmt::format("{}: LiDAR.Tr overrides the dataset's LiDAR extrinsics", s.file.string()));
@@ -203,6 +204,7 @@ SensorFrame Pipeline::sensor_frame(const FrameInput& input) const {
   frame.image_right = input.images[static_cast<std::size_t>(camera_ + 1)];
   frame.depth_image = input.depth;
   frame.scan = input.scan;
+  frame.scan_timestamp = input.scan_timestamp;
   return frame;
 }
 
@@ -216,6 +218,8 @@ struct InFlight {
   FrameInput input;
   SensorFrame sensor;
   PreparedFrame prepared;
+  FrameBuilder* builder = nullptr;  // the pipeline's, which outlive the frames in flight
+  bool late_depth = false;          // its scan moved on the tracking thread (System::scan_moves)
   double io_wait_ms = 0.0;
   TaskPool::Task build;  // last: destroyed (waited for) before what it writes to
 };
@@ -279,7 +283,9 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
     // The next `threads` frames are built on the pool (each one's levels spread over every thread)
     // while frame i is tracked here, so a core is never idle while tracking runs. One builder per
     // frame in flight, as each depth source holds the frame it prepared. A build is a function of
-    // its frame alone, so the trajectory is the one of a single thread.
+    // its frame alone, except for a scan moved to the image's time by the motion tracked so far
+    // (System::scan_moves): that part is finished here, before the builder is reused. The trajectory
+    // is the one of a single thread.
     const auto pool = std::make_shared<TaskPool>(threads_);
     const auto ahead_max = static_cast<std::size_t>(threads_);
     std::vector<FrameBuilder> builders;
@@ -304,7 +310,11 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
         f->input = std::move(*input);
         f->sensor = sensor_frame(f->input);
         FrameBuilder& builder = builders[started++ % ahead_max];
-        f->build = pool->submit([&builder, f = f.get()] { f->prepared = builder.build(f->sensor); });
+        f->builder = &builder;
+        f->late_depth = !f->sensor.scan.empty() && system->scan_moves(f->sensor);
+        f->build = pool->submit([&builder, f = f.get()] {
+          f->prepared = f->late_depth ? builder.build_ahead(f->sensor) : builder.build(f->sensor);
+        });
         ahead.push_back(std::move(f));
       }
     };
@@ -316,6 +326,10 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
       Stopwatch wait;
       current->build.wait();  // helps with queued builds meanwhile; rethrows what building threw
       current->prepared.critical_ms = wait.elapsed_ms();
+      if (current->late_depth) {
+        current->sensor.T_image_scan = system->scan_motion(current->sensor);
+        current->builder->finish(current->prepared, current->sensor);
+      }
       if (!stop.stop_requested()) fill();  // the builds overlap the tracking below
       FrameRecord record;
       pacer.wait_for(current->sensor.timestamp, stop);
@@ -414,6 +428,15 @@ bool RunResult::failed() const { return !stopped && !frames.empty() && tracked_c
 std::size_t RunResult::keyframe_count() const {
   return static_cast<std::size_t>(
       std::count_if(frames.begin(), frames.end(), [](const FrameRecord& r) { return r.result.keyframe; }));
+}
+
+std::optional<double> RunResult::scan_age_median() const {
+  std::vector<double> ages;
+  for (const FrameRecord& f : frames) ages.push_back(f.result.scan_age);
+  if (ages.empty()) return std::nullopt;
+  const auto mid = ages.begin() + static_cast<std::ptrdiff_t>(ages.size() / 2);
+  std::nth_element(ages.begin(), mid, ages.end());
+  return *mid;
 }
 
 std::optional<int> RunResult::min_inliers_ok() const {

@@ -25,6 +25,9 @@ void SystemOptions::validate() const {
   depth_noise.validate();
   map.validate();
   loop_closing.validate();
+  require(!scan_time_offset || (std::isfinite(*scan_time_offset) && std::abs(*scan_time_offset) <= 1.0),
+          "scan_time_offset", "seconds from the scan to the image, -1 .. 1");
+  require(std::isfinite(frame_period) && frame_period > 0.0, "frame_period", "seconds > 0");
 }
 
 namespace {
@@ -204,22 +207,6 @@ struct System::Impl {
   }
 
   bool mapping_idle() const { return !options.threaded_mapping || mapping_queue.idle(); }
-
-  // Each keypoint's depth moved to the frame's trigger time: the scan sweeps while the car moves.
-  void compensate_lidar_motion(Frame& frame) const {
-    const Vector6d xi = se3_log(*tracker.velocity());  // per frame period
-    const Eigen::Isometry3d T_lidar_cam = calibration.T_cam_lidar.inverse();
-    const double per_radian = options.lidar_spin * options.lidar_scan_period / (2.0 * M_PI) / options.frame_period;
-    for (std::size_t i = 0; i < frame.size(); ++i) {
-      if (frame.depth[i] <= 0.0F) continue;
-      const Eigen::Vector3d p = calibration.camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y),
-                                                             frame.depth[i]);
-      const Eigen::Vector3d p_lidar = T_lidar_cam * p;
-      const double fraction = per_radian * std::atan2(p_lidar.y(), p_lidar.x());  // frames before the trigger
-      const Eigen::Vector3d corrected = se3_exp(fraction * xi) * p;
-      frame.depth[i] = static_cast<float>(corrected.z());
-    }
-  }
 };
 
 System::System(SystemOptions options, CameraCalibration calibration, std::unique_ptr<DepthSource> depth,
@@ -267,7 +254,29 @@ TrackResult System::track(const SensorFrame& sensor) {
   if (!impl_->builder) {
     throw std::logic_error("System::track(sensor): this System has no depth source and extractor; pass the built frame");
   }
-  return track(sensor, impl_->builder->build(sensor));
+  if (!scan_moves(sensor)) return track(sensor, impl_->builder->build(sensor));
+  SensorFrame moved = sensor;
+  moved.T_image_scan = scan_motion(sensor);
+  return track(sensor, impl_->builder->build(moved));
+}
+
+bool System::scan_moves(const SensorFrame& sensor) const { return scan_age(sensor) != 0.0; }
+
+double System::scan_age(const SensorFrame& sensor) const {
+  if (impl_->options.scan_time_offset) return *impl_->options.scan_time_offset;
+  return sensor.scan_timestamp ? sensor.timestamp - *sensor.scan_timestamp : 0.0;
+}
+
+Eigen::Isometry3d System::scan_motion(const SensorFrame& sensor) const {
+  const Impl& s = *impl_;
+  const double age = scan_age(sensor);
+  const auto& velocity = s.tracker.velocity();
+  const double dt = s.tracker.velocity_dt();
+  // beyond a second apart the two are not one trigger's: no motion is assumed rather than a wrong one
+  if (age == 0.0 || !(std::abs(age) <= 1.0) || !has_pose(s.tracker.state()) || !velocity || !(dt > 0.0)) {
+    return Eigen::Isometry3d::Identity();
+  }
+  return se3_exp(se3_log(*velocity) * (age / dt));
 }
 
 TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
@@ -281,10 +290,8 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   const std::size_t n = frame.size();
   const int with_depth = prepared.keypoints_with_depth;
   result.timing.extraction_ms = prepared.extraction_ms;
-  if (s.options.lidar_scan_period > 0.0 && has_pose(s.tracker.state()) && s.tracker.velocity()) {
-    s.compensate_lidar_motion(frame);
-  }
-  result.timing.depth_ms = prepared.depth_ms + stage.lap_ms();
+  result.timing.depth_ms = prepared.depth_ms;
+  if (!sensor.scan.empty()) result.scan_age = scan_age(sensor);
 
   // A loop thread's correction waits for this frame to be tracked and recorded (uncontended inline).
   const std::lock_guard gate(s.tracking_gate);

@@ -10,6 +10,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -225,4 +226,44 @@ TEST_CASE("KITTI raw loader: frame timestamps must increase strictly", "[io][kit
                 "2011-01-01 10:00:02.500000000\n2011-01-01 10:00:01.500000000\n2011-01-01 10:00:03.500000000\n");
   CHECK_THAT(rgbl::test::parse_error_message([&] { rgbl::read_kitti_raw_timestamps(times); }, times),
              Contains(":2: timestamp"));
+}
+
+TEST_CASE("KITTI raw loader: each scan's forward-facing time from velodyne_points/timestamps.txt", "[io][kitti-raw]") {
+  SyntheticRaw raw;
+  CHECK_FALSE(rgbl::open_kitti_raw(raw.drive)->load(1).scan_timestamp);  // no file: the dataset does not say
+  raw.tmp.write("2011_01_01_drive_0001_sync/velodyne_points/timestamps.txt",
+                "2011-01-01 10:00:00.480000000\n2011-01-01 10:00:01.483000000\n2011-01-01 10:00:02.490000000\n");
+  const auto seq = rgbl::open_kitti_raw(raw.drive);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const rgbl::FrameInput frame = seq->load(i);
+    REQUIRE(frame.scan_timestamp);
+    CHECK_THAT(frame.timestamp - *frame.scan_timestamp, WithinAbs(std::array{0.020, 0.017, 0.010}[i], 1e-6));
+  }
+  SECTION("a count that differs names the file") {
+    const auto file = raw.tmp.write("2011_01_01_drive_0001_sync/velodyne_points/timestamps.txt",
+                                    "2011-01-01 10:00:00.480000000\n");
+    CHECK_THROWS_WITH(rgbl::open_kitti_raw(raw.drive), Contains(file.string()) && Contains("has 1 timestamps, expected 3"));
+  }
+  SECTION("a scan more than a second from its image is not the image's") {
+    const auto file = raw.tmp.write("2011_01_01_drive_0001_sync/velodyne_points/timestamps.txt",
+                                    "2011-01-01 10:00:00.480000000\n2011-01-01 10:00:03.483000000\n"
+                                    "2011-01-01 10:00:02.490000000\n");
+    CHECK_THROWS_WITH(rgbl::open_kitti_raw(raw.drive),
+                      Contains(file.string()) && Contains("frame 1: expected the scan within 1 s of the image") &&
+                          Contains("-1.983 s apart"));
+  }
+}
+
+TEST_CASE("KITTI raw drive: the cameras' timestamps come 16.6-17.1 ms after the scan faced forward",
+          "[io][kitti-raw][data]") {
+  const auto dir = rgbl::test::find_data("kitti/raw/2011_09_26/2011_09_26_drive_0009_sync");
+  if (!dir) return;
+  const auto seq = rgbl::open_sequence(*dir);
+  for (std::size_t i = 0; i < seq->size(); ++i) {
+    const rgbl::FrameInput frame = seq->load(i);
+    REQUIRE(frame.scan_timestamp);
+    const double age = frame.timestamp - *frame.scan_timestamp;
+    CHECK(age > 0.0166);
+    CHECK(age < 0.0171);
+  }
 }

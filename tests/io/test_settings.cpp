@@ -187,6 +187,15 @@ TEST_CASE("settings: rgbl's LiDAR occlusion keys", "[io][settings]") {
              Contains("'LiDAR.OcclusionRatio': expected a depth ratio > 1"));
 }
 
+TEST_CASE("settings: LiDAR.TimeOffset, the image's time minus the scan's", "[io][settings]") {
+  rgbl::test::TempDir tmp;
+  CHECK(rgbl::read_settings(tmp.write("t.yaml", "%YAML:1.0\nLiDAR.TimeOffset: 0.0169\n")).scan_time_offset == 0.0169);
+  CHECK(rgbl::read_settings(tmp.write("z.yaml", "%YAML:1.0\nLiDAR.TimeOffset: 0\n")).scan_time_offset == 0.0);
+  CHECK_FALSE(rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n")).scan_time_offset);
+  CHECK_THAT(error_of(tmp.write("far.yaml", "%YAML:1.0\nLiDAR.TimeOffset: 1.5\n")),
+             Contains("'LiDAR.TimeOffset': expected seconds from the scan to the image, -1 .. 1"));
+}
+
 TEST_CASE("settings: LocalMapping.PlaceCulling switches keyframe culling by revisits", "[io][settings]") {
   rgbl::test::TempDir tmp;
   const auto off = rgbl::read_settings(tmp.write("off.yaml", "%YAML:1.0\nLocalMapping.PlaceCulling: 0\n"));

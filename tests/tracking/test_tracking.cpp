@@ -1,6 +1,7 @@
 #include "kitti_run.hpp"
 #include "reliability/failure_run.hpp"
 #include "rgbl/core/error.hpp"
+#include "rgbl/geometry/se3.hpp"
 #include "rgbl/tracking/frame.hpp"
 #include "rgbl/tracking/frame_builder.hpp"
 #include "rgbl/tracking/system.hpp"
@@ -193,6 +194,33 @@ TEST_CASE("relocalisation neither changes nor depends on the caller's OpenCV gen
       CHECK(o.trajectory[i].T_world_cam.matrix() == first[i].T_world_cam.matrix());
     }
   }
+}
+
+TEST_CASE("system: the camera's motion from a frame's scan to its image, from the tracked velocity") {
+  const auto dir = rgbl::test::kitti_seq04();
+  if (!dir) return;
+  BuiltSeq04 t(*dir);
+  rgbl::SensorFrame frame = t.load(0);
+  frame.scan_timestamp = frame.timestamp - 0.017;
+  CHECK(t.system.scan_moves(frame));
+  CHECK(t.system.scan_motion(frame).matrix() == Eigen::Matrix4d::Identity());  // nothing tracked yet
+  for (std::size_t i = 0; i < 6; ++i) REQUIRE(rgbl::has_pose(t.track(t.load(i)).state));
+  frame = t.load(6);
+  CHECK_FALSE(t.system.scan_moves(frame));  // the odometry format gives no scan times
+  CHECK(t.system.scan_motion(frame).matrix() == Eigen::Matrix4d::Identity());
+  frame.scan_timestamp = frame.timestamp - 0.017;
+  CHECK_THAT(t.system.scan_age(frame), Catch::Matchers::WithinAbs(0.017, 1e-9));
+  const Eigen::Isometry3d T_image_scan = t.system.scan_motion(frame);
+  // the truth's step 5 -> 6, over 17 ms of its 103.6 ms: the car drives 13.3 m/s along the camera's z
+  const auto& gt = t.sequence->ground_truth()->poses;
+  const Eigen::Isometry3d T_6_5 = gt[6].inverse() * gt[5];
+  const double share = 0.017 / (t.sequence->timestamp(6) - t.sequence->timestamp(5));
+  CHECK(T_image_scan.translation().z() < -0.2);
+  CHECK((T_image_scan.translation() - share * T_6_5.translation()).norm() < 0.01);
+  CHECK(rgbl::rotation_angle(T_image_scan.linear()) < 1e-3);
+  // a scan more than a second away is not this image's: nothing is moved
+  frame.scan_timestamp = frame.timestamp - 1.5;
+  CHECK(t.system.scan_motion(frame).matrix() == Eigen::Matrix4d::Identity());
 }
 
 // The threaded-mapping test lives in tests/reliability/test_threaded.cpp (label `threaded`, run under TSan).

@@ -8,9 +8,11 @@
 #include "rgbl/geometry/point_cloud.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core/mat.hpp>
 
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string_view>
 
@@ -24,6 +26,13 @@ struct SensorFrame {
   cv::Mat image_right;        // rectified right image of a stereo pair; empty if none
   cv::Mat depth_image;        // a depth camera's or precomputed depth (CV_16UC1 or CV_32FC1); empty if none
   PointCloudView scan;        // LiDAR scan in the LiDAR frame; empty if none
+  // When the scan faced forward, seconds, on the clock of `timestamp` (KITTI raw: velodyne_points/
+  // timestamps.txt); unset when the dataset does not say. SystemOptions::scan_time_offset overrides it.
+  std::optional<double> scan_timestamp;
+  // The camera's motion from the scan's time to the image's: maps points in the camera frame at the
+  // scan's time into the camera frame at the image's. A source that measures at the scan's time
+  // projects the scan with it (System::scan_motion sets it; identity: the two are simultaneous).
+  Eigen::Isometry3d T_image_scan = Eigen::Isometry3d::Identity();
 };
 
 // Depth at one keypoint. z == 0 means "no depth here".
@@ -66,6 +75,10 @@ class DepthSource {
   // The dense (completed) depth map of the prepared frame, metres, 0 = none: for visualisation and
   // evaluation; may be computed on demand.
   virtual cv::Mat_<float> dense_depth() const = 0;
+
+  // true when the depth is the scan's, measured at the scan's time rather than the image's, and
+  // prepare() moves it by SensorFrame::T_image_scan.
+  virtual bool measured_at_scan_time() const { return false; }
 };
 
 }  // namespace rgbl

@@ -22,6 +22,7 @@ struct FrameInput {
   std::array<cv::Mat, 4> images;
   cv::Mat_<float> depth;                          // depth camera (TUM), metres, 0 = none; empty if none
   std::vector<LidarPoint> scan;                   // LiDAR frame; empty if none
+  std::optional<double> scan_timestamp;           // when the scan faced forward (KITTI raw), same clock
   std::optional<Eigen::Isometry3d> T_world_cam0;  // ground truth, when the dataset has it
 
   const cv::Mat& grey_left() const { return images[0]; }

@@ -121,6 +121,8 @@ struct RunResult {
   bool failed() const;
   std::size_t keyframe_count() const;
   std::optional<int> min_inliers_ok() const;  // fewest local-map inliers on a frame reported ok
+  // s, the median over the frames of the time their LiDAR depth was moved by (TrackResult::scan_age)
+  std::optional<double> scan_age_median() const;
   RunTimings timings() const;
   // Dataset indices of the frames whose TrackResult satisfies `selected`, e.g. [](auto& r) { return r.jump; }.
   template <typename Selected>

@@ -37,10 +37,22 @@ class FrameBuilder {
 
   // Throws what the depth source throws on input it cannot use (e.g. no right image for stereo).
   PreparedFrame build(const SensorFrame& sensor);
+  // build() in two steps, for a frame whose scan is moved by the motion tracked up to the previous
+  // frame (SensorFrame::T_image_scan, System::scan_motion). build_ahead: what does not depend on that
+  // motion (the features; the depth too unless the source measures at the scan's time), a function
+  // of the frame alone. finish: the rest, with the motion set, on the calling thread. Together they
+  // give what build() gives for the same sensor frame.
+  PreparedFrame build_ahead(const SensorFrame& sensor);
+  void finish(PreparedFrame& prepared, const SensorFrame& sensor);
 
   const DepthSource& depth_source() const { return *depth_; }
 
  private:
+  PreparedFrame build(const SensorFrame& sensor, bool whole);
+  void extract(const SensorFrame& sensor, PreparedFrame& out);
+  void sample_scan_points(const SensorFrame& sensor, Frame& frame) const;
+  void sample_depth(PreparedFrame& out);
+
   CameraCalibration calibration_;
   DepthNoiseModel noise_;
   std::unique_ptr<DepthSource> depth_;

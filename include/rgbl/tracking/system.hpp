@@ -31,14 +31,13 @@ struct SystemOptions {
   // false: local mapping and loop closing run inside track() and the same input gives a bit-identical
   // trajectory. true: local mapping in a thread of its own, and loop closing in another.
   bool threaded_mapping = false;
-  // Motion compensation of LiDAR depth: a spinning LiDAR measures a point at azimuth a (0 = ahead,
-  // positive to the left) at a time offset of -spin * a / (2 pi) * scan_period from the camera
-  // trigger (taken when the LiDAR faces forward, as on KITTI). With the constant-velocity estimate the
-  // keypoint depth is moved to the camera time. At 14 m/s a point 60 degrees to the side is off by
-  // ~0.25 m, which is a scale bias when one side dominates. 0 = off.
-  double lidar_scan_period = 0.0;      // s (KITTI HDL-64E: 0.1)
-  double lidar_spin = 1.0;             // +1: left side scanned before the front (clockwise from above)
-  double frame_period = 0.1;           // s between frames, to scale the velocity
+  // LiDAR depth moved to the image's time (SensorFrame::T_image_scan) with the constant-velocity
+  // estimate: a LiDAR that triggers the camera still measures before the exposure (KITTI raw: 16.9 ms,
+  // 17 cm at 10 m/s). scan_time_offset: the image's time minus the scan's, for every frame; unset =
+  // the dataset's scan timestamps (SensorFrame::scan_timestamp; KITTI raw has them), else 0
+  // (simultaneous, nothing moved).
+  std::optional<double> scan_time_offset;  // s, |.| <= 1
+  double frame_period = 0.1;       // s between frames given without a timestamp (Python's System.track)
 
   void validate() const;
 };
@@ -69,6 +68,8 @@ struct TrackResult {
   bool step_rejected = false;  // a step beyond a vehicle's reach on weak evidence: weak, at the prediction
   int inliers = 0;           // local-map inliers (ok needs 30, 50 after a relocalisation)
   int keypoints = 0, keypoints_with_depth = 0;
+  // s, the image's time minus its scan's, by which the LiDAR depth was moved (System::scan_age; 0 without)
+  double scan_age = 0.0;
   std::size_t map_keyframes = 0, map_landmarks = 0;  // the map's size after this frame
   // A loop closed: inline, on this frame (a keyframe); threaded, by the loop thread since the last
   // frame (its frame_index says which keyframe closed it). The map was corrected.
@@ -105,7 +106,20 @@ class System {
   TrackResult track(const SensorFrame& frame);
   // The same with the frame built beforehand (e.g. on another thread, by a FrameBuilder of its own):
   // `sensor` is the frame it was built from, still needed for its scan (loop closing).
+  // A LiDAR frame's depth is the image's only when built from a sensor frame with T_image_scan =
+  // scan_motion(sensor), taken after the previous frame was tracked (FrameBuilder::add_depth).
   TrackResult track(const SensorFrame& sensor, PreparedFrame prepared);
+
+  // The camera's motion from the frame's scan to its image (SensorFrame::T_image_scan), from the
+  // constant-velocity estimate of the frames tracked so far: identity before two tracked frames,
+  // while lost, or when the two are simultaneous. Depends on the tracking state: take it for the
+  // next frame, after the previous one was tracked.
+  Eigen::Isometry3d scan_motion(const SensorFrame& sensor) const;
+  // Whether scan_motion can be other than the identity for this frame (scan_age != 0): then its
+  // depth is built after the previous frame was tracked.
+  bool scan_moves(const SensorFrame& sensor) const;
+  // The image's time minus the scan's (SystemOptions::scan_time_offset, else the frame's own times).
+  double scan_age(const SensorFrame& sensor) const;
 
   // Waits until threaded mapping and loop closing have processed every queued keyframe (no-op when
   // inline); the trajectory then includes every correction. Rethrows a worker thread's exception.

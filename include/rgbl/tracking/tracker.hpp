@@ -54,6 +54,7 @@ class Tracker {
   KeyframeId reference_keyframe() const { return reference_; }
   // Constant-velocity motion T_cur_last of the last tracked frame pair, if any.
   const std::optional<Eigen::Isometry3d>& velocity() const { return velocity_; }
+  double velocity_dt() const { return velocity_dt_; }  // s between the frames of velocity()
 
  private:
   // What a local-map search around a frame's pose found.
