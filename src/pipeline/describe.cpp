@@ -38,11 +38,16 @@ std::string describe_sequence(const Sequence& seq) {
     LoadOptions lidar_only;
     lidar_only.cameras = {false, false, false, false};
     lidar_only.depth = false;
-    const std::size_t points = seq.load(0, lidar_only).scan.size();
+    const FrameInput first = seq.load(0, lidar_only);
     fmt::format_to(out,
                    "lidar:         {} points in frame 0; T_cam0_lidar t = ({:.4f}, {:.4f}, {:.4f}) m; cam0 sits at "
                    "({:.3f}, {:.3f}, {:.3f}) m in the LiDAR frame\n",
-                   points, t.x(), t.y(), t.z(), cam0_in_lidar.x(), cam0_in_lidar.y(), cam0_in_lidar.z());
+                   first.scan.size(), t.x(), t.y(), t.z(), cam0_in_lidar.x(), cam0_in_lidar.y(), cam0_in_lidar.z());
+    if (first.scan_timestamp) {
+      // the LiDAR depth is moved by the camera's motion over this time (docs/depth.md)
+      fmt::format_to(out, "scan times:    frame 0's image {:.1f} ms after its scan faced forward\n",
+                     (first.timestamp - *first.scan_timestamp) * 1000.0);
+    }
   } else {
     fmt::format_to(out, "lidar:         none\n");
   }

@@ -124,6 +124,11 @@ TEST_CASE("a sequence described as `rgbl info` prints it: its frames, sensors an
   CHECK_THAT(text, Catch::Contains("camera 0:      grey left"));
   CHECK_THAT(text, Catch::Contains(fmt::format("lidar:         {} points in frame 0", seq->load(0).scan.size())));
   CHECK_THAT(text, Catch::Contains(fmt::format("ground truth:  {} poses", seq->size())));
+  CHECK_THAT(text, !Catch::Contains("scan times:"));  // the simulator's scans are the images' own
+  if (const auto raw = rgbl::test::find_data("kitti/raw/2011_09_26/2011_09_26_drive_0009_sync")) {
+    CHECK_THAT(rgbl::describe_sequence(*rgbl::open_sequence(*raw)),
+               Catch::Contains("scan times:    frame 0's image 16.7 ms after its scan faced forward"));
+  }
 }
 
 TEST_CASE("the settings file's LiDAR occlusion keys reach the LiDAR source") {
