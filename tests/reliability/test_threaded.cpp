@@ -124,6 +124,16 @@ TEST_CASE("frame threads: frames built ahead on a pool, the same poses as one th
   rgbl::test::check_thread_counts_agree(o, {3});
 }
 
+TEST_CASE("frame threads: a raw drive's LiDAR depth finished on the tracking thread, the same poses as one thread") {
+  // KITTI raw gives scan times: each frame's features are built ahead, its scan moved by the tracked
+  // motion and projected on the tracking thread (FrameBuilder::build_ahead / finish)
+  const auto drive = rgbl::test::find_data("kitti/raw/2011_09_26/2011_09_26_drive_0009_sync");
+  if (!drive) return;
+  rgbl::PipelineOptions o;
+  o.dataset = *drive;
+  rgbl::test::check_thread_counts_agree(o, {3});
+}
+
 namespace {
 // A recogniser of the user's that fails: its exception must reach the caller of track() or finish().
 class FailingRecognizer final : public rgbl::PlaceRecognizer {
