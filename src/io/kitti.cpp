@@ -365,13 +365,21 @@ std::unique_ptr<Sequence> open_kitti_raw(const fs::path& drive_dir, const LoadOp
   if (table.sensors.lidar && scan_times_file != time_source && fs::exists(scan_times_file, ec)) {
     const auto scan_times = read_raw_timestamps(scan_times_file, false);
     check_count(scan_times_file, scan_times.size(), count, "timestamps");
+    // a scan more than a second from its image is a glitch of the log, not a latency: that frame's
+    // depth is taken as simultaneous, and the run goes on
+    std::vector<std::size_t> apart;
     for (std::size_t i = 0; i < count; ++i) {
-      if (!(std::abs(times[i] - scan_times[i]) <= 1.0)) {
-        throw ParseError(scan_times_file, 0,
-                         fmt::format("frame {}: expected the scan within 1 s of the image ({}), found {:.3f} s apart",
-                                     i, time_source.string(), times[i] - scan_times[i]));
+      if (std::abs(times[i] - scan_times[i]) <= 1.0) {
+        table.frames[i].scan_timestamp = scan_times[i];
+      } else {
+        apart.push_back(i);
       }
-      table.frames[i].scan_timestamp = scan_times[i];
+    }
+    if (!apart.empty()) {
+      table.notes.push_back(fmt::format("{}: {} scan time(s) more than 1 s from the image's ({}), first at frame {} "
+                                        "({:.3f} s); those frames' LiDAR depth is taken as simultaneous",
+                                        scan_times_file.string(), apart.size(), time_source.string(), apart.front(),
+                                        times[apart.front()] - scan_times[apart.front()]));
     }
   }
 

@@ -244,13 +244,22 @@ TEST_CASE("KITTI raw loader: each scan's forward-facing time from velodyne_point
                                     "2011-01-01 10:00:00.480000000\n");
     CHECK_THROWS_WITH(rgbl::open_kitti_raw(raw.drive), Contains(file.string()) && Contains("has 1 timestamps, expected 3"));
   }
-  SECTION("a scan more than a second from its image is not the image's") {
+  SECTION("a scan more than a second from its image is a glitch: that frame has no scan time, and a note says so") {
     const auto file = raw.tmp.write("2011_01_01_drive_0001_sync/velodyne_points/timestamps.txt",
                                     "2011-01-01 10:00:00.480000000\n2011-01-01 10:00:03.483000000\n"
                                     "2011-01-01 10:00:02.490000000\n");
-    CHECK_THROWS_WITH(rgbl::open_kitti_raw(raw.drive),
-                      Contains(file.string()) && Contains("frame 1: expected the scan within 1 s of the image") &&
-                          Contains("-1.983 s apart"));
+    const auto glitch = rgbl::open_kitti_raw(raw.drive);
+    CHECK(glitch->load(0).scan_timestamp);
+    CHECK_FALSE(glitch->load(1).scan_timestamp);
+    CHECK(glitch->load(2).scan_timestamp);
+    REQUIRE(glitch->notes().size() == 1);
+    CHECK_THAT(glitch->notes()[0], Contains(file.string()) && Contains("1 scan time(s) more than 1 s") &&
+                                       Contains("first at frame 1 (-1.983 s)"));
+  }
+  SECTION("a malformed scan time names the file and line") {
+    const auto file = raw.tmp.write("2011_01_01_drive_0001_sync/velodyne_points/timestamps.txt",
+                                    "2011-01-01 10:00:00.480000000\nnot a time\n2011-01-01 10:00:02.490000000\n");
+    CHECK_THROWS_WITH(rgbl::open_kitti_raw(raw.drive), Contains(file.string() + ":2:"));
   }
 }
 
