@@ -107,7 +107,7 @@ class System {
   // The same with the frame built beforehand (e.g. on another thread, by a FrameBuilder of its own):
   // `sensor` is the frame it was built from, still needed for its scan (loop closing).
   // A LiDAR frame's depth is the image's only when built from a sensor frame with T_image_scan =
-  // scan_motion(sensor), taken after the previous frame was tracked (FrameBuilder::add_depth).
+  // scan_motion(sensor), taken after the previous frame was tracked (FrameBuilder::build_ahead, finish).
   TrackResult track(const SensorFrame& sensor, PreparedFrame prepared);
 
   // The camera's motion from the frame's scan to its image (SensorFrame::T_image_scan), from the
