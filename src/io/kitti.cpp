@@ -3,6 +3,7 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/file.hpp"
 #include "rgbl/core/log.hpp"
+#include "rgbl/geometry/point_cloud.hpp"
 #include "rgbl/geometry/se3.hpp"
 #include "rgbl/io/kitti_raw.hpp"
 #include "rgbl/io/sequence.hpp"
@@ -365,11 +366,11 @@ std::unique_ptr<Sequence> open_kitti_raw(const fs::path& drive_dir, const LoadOp
   if (table.sensors.lidar && scan_times_file != time_source && fs::exists(scan_times_file, ec)) {
     const auto scan_times = read_raw_timestamps(scan_times_file, false);
     check_count(scan_times_file, scan_times.size(), count, "timestamps");
-    // a scan more than a second from its image is a glitch of the log, not a latency: that frame's
-    // depth is taken as simultaneous, and the run goes on
+    // beyond kMaxScanAge a glitch of the log, not a latency: that frame's depth is taken as
+    // simultaneous, and the run goes on
     std::vector<std::size_t> apart;
     for (std::size_t i = 0; i < count; ++i) {
-      if (std::abs(times[i] - scan_times[i]) <= 1.0) {
+      if (std::abs(times[i] - scan_times[i]) <= kMaxScanAge) {
         table.frames[i].scan_timestamp = scan_times[i];
       } else {
         apart.push_back(i);

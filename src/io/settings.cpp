@@ -4,6 +4,7 @@
 
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/file.hpp"
+#include "rgbl/geometry/point_cloud.hpp"
 
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
@@ -351,7 +352,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
     s.occlusion_ratio = *v;
   }
   if (const auto v = r.number({"LiDAR.TimeOffset"})) {
-    if (!(std::abs(*v) <= 1.0)) r.fail("LiDAR.TimeOffset", "seconds from the scan to the image, -1 .. 1");
+    if (!(std::abs(*v) <= kMaxScanAge)) r.fail("LiDAR.TimeOffset", "seconds from the scan to the image, -1 .. 1");
     s.scan_time_offset = *v;
   }
 

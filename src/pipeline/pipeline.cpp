@@ -431,12 +431,11 @@ std::size_t RunResult::keyframe_count() const {
 }
 
 std::optional<double> RunResult::scan_age_median() const {
+  if (frames.empty()) return std::nullopt;
   std::vector<double> ages;
+  ages.reserve(frames.size());
   for (const FrameRecord& f : frames) ages.push_back(f.result.scan_age);
-  if (ages.empty()) return std::nullopt;
-  const auto mid = ages.begin() + static_cast<std::ptrdiff_t>(ages.size() / 2);
-  std::nth_element(ages.begin(), mid, ages.end());
-  return *mid;
+  return stage_stats(std::move(ages)).median;
 }
 
 std::optional<int> RunResult::min_inliers_ok() const {

@@ -39,11 +39,12 @@ PreparedFrame FrameBuilder::build(const SensorFrame& sensor, bool whole) {
     if (with_depth) depth_->prepare(sensor);
     prepare_ms = t.elapsed_ms();
   };
-  // the preparation beside extraction when there is a second thread; its exception after both
+  // the preparation beside extraction when there is a second thread; its exception after both.
+  // Ahead of a LiDAR source's finish() there is nothing to prepare (whole implies with_depth).
   TaskPool::Task prepared;
-  if (pool_ && pool_->threads() > 1) {
+  if (with_depth && pool_ && pool_->threads() > 1) {
     prepared = pool_->submit(prepare);
-  } else {
+  } else if (with_depth) {
     prepare();
   }
   extract(sensor, out);

@@ -25,7 +25,7 @@ void SystemOptions::validate() const {
   depth_noise.validate();
   map.validate();
   loop_closing.validate();
-  require(!scan_time_offset || (std::isfinite(*scan_time_offset) && std::abs(*scan_time_offset) <= 1.0),
+  require(!scan_time_offset || (std::isfinite(*scan_time_offset) && std::abs(*scan_time_offset) <= kMaxScanAge),
           "scan_time_offset", "seconds from the scan to the image, -1 .. 1");
   require(std::isfinite(frame_period) && frame_period > 0.0, "frame_period", "seconds > 0");
 }
@@ -272,8 +272,8 @@ Eigen::Isometry3d System::scan_motion(const SensorFrame& sensor) const {
   const double age = scan_age(sensor);
   const auto& velocity = s.tracker.velocity();
   const double dt = s.tracker.velocity_dt();
-  // beyond a second apart the two are not one trigger's: no motion is assumed rather than a wrong one
-  if (age == 0.0 || !(std::abs(age) <= 1.0) || !has_pose(s.tracker.state()) || !velocity || !(dt > 0.0)) {
+  // a scan time set by hand (Python) may be a glitch too: no motion rather than a wrong one
+  if (age == 0.0 || !(std::abs(age) <= kMaxScanAge) || !has_pose(s.tracker.state()) || !velocity || !(dt > 0.0)) {
     return Eigen::Isometry3d::Identity();
   }
   return se3_exp(se3_log(*velocity) * (age / dt));

@@ -211,7 +211,7 @@ TEST_CASE("system: the camera's motion from a frame's scan to its image, from th
   frame.scan_timestamp = frame.timestamp - 0.017;
   CHECK_THAT(t.system.scan_age(frame), Catch::Matchers::WithinAbs(0.017, 1e-9));
   const Eigen::Isometry3d T_image_scan = t.system.scan_motion(frame);
-  // the truth's step 5 -> 6, over 17 ms of its 103.6 ms: the car drives 13.3 m/s along the camera's z
+  // the truth's step 5 -> 6 (1.33 m in 104.2 ms, 12.7 m/s along the camera's z), over 17 ms of it
   const auto& gt = t.sequence->ground_truth()->poses;
   const Eigen::Isometry3d T_6_5 = gt[6].inverse() * gt[5];
   const double share = 0.017 / (t.sequence->timestamp(6) - t.sequence->timestamp(5));

@@ -28,6 +28,9 @@ PointCloudView view_kitti_scan(std::span<const float> packed);
 
 // The most points read_kitti_scan reads from one file: 10 million (160 MB; a KITTI scan has ~120 000).
 inline constexpr std::size_t kMaxScanPoints = 10'000'000;
+// Seconds between a scan and its image beyond which the two are not one trigger's (KITTI: 17 ms
+// apart): such a scan time is a glitch of the log, and the scan is taken as simultaneous.
+inline constexpr double kMaxScanAge = 1.0;
 
 // Reads a KITTI .bin into `points` (reusing its capacity). Throws ParseError naming the file when it
 // is not a readable regular file, its size is not a multiple of 16 bytes or it holds more than
