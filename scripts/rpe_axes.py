@@ -7,7 +7,8 @@
 For each pair of consecutive frames, E = (T_gt_i^-1 T_gt_i+1)^-1 (T_est_i^-1 T_est_i+1); prints the mean
 (bias) and RMS (jitter) of E's rotation about x (pitch), y (yaw), z (roll) in degrees and of its
 translation in metres (x right, y down, z forward); then the five steps with the largest translation
-error, and the ATE by axis after a rigid (SE(3)) alignment, in the first frame's axes. Given a run
+error, and the ATE by axis after a rigid (SE(3)) alignment, in the first frame's axes (and the ATE
+after a similarity alignment, with its scale). Given a run
 folder with timing.csv, also the same rotation error between consecutive keyframes (the frames made
 keyframes, at their written poses). Needs python3-numpy.
 """
@@ -78,13 +79,17 @@ def main():
     # ATE: the estimated positions rigidly aligned to the true ones (Kabsch/Umeyama without scale)
     p_est, p_gt = est[:n, :3, 3], gt[:n, :3, 3]
     mu_est, mu_gt = p_est.mean(axis=0), p_gt.mean(axis=0)
-    U, _, Vt = np.linalg.svd((p_est - mu_est).T @ (p_gt - mu_gt))
+    U, S, Vt = np.linalg.svd((p_est - mu_est).T @ (p_gt - mu_gt))
     D = np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))])
     R = Vt.T @ D @ U.T
     err = (p_est - mu_est) @ R.T + mu_gt - p_gt
     print("ATE m (aligned)  x        y        z")
     print("  rms           " + "".join(f"{v:9.4f}" for v in np.sqrt((err ** 2).mean(axis=0)))
           + f"   (all {np.sqrt((err ** 2).sum(axis=1).mean()):.4f})")
+    # the same with a scale (similarity alignment): how much of the ATE is a scale error
+    scale = (S * np.diag(D)).sum() / ((p_est - mu_est) ** 2).sum()
+    err = scale * (p_est - mu_est) @ R.T + mu_gt - p_gt
+    print(f"  with a scale {scale:.4f}: {np.sqrt((err ** 2).sum(axis=1).mean()):.4f}")
 
 
 if __name__ == "__main__":

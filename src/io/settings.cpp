@@ -352,7 +352,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
     s.occlusion_ratio = *v;
   }
   if (const auto v = r.number({"LiDAR.TimeOffset"})) {
-    if (!(std::abs(*v) <= kMaxScanAge)) r.fail("LiDAR.TimeOffset", "seconds from the scan to the image, -1 .. 1");
+    if (!(std::abs(*v) <= kMaxScanAge)) r.fail("LiDAR.TimeOffset", kScanAgeExpected);
     s.scan_time_offset = *v;
   }
 

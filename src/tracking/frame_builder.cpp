@@ -42,10 +42,12 @@ PreparedFrame FrameBuilder::build(const SensorFrame& sensor, bool whole) {
   // the preparation beside extraction when there is a second thread; its exception after both.
   // Ahead of a LiDAR source's finish() there is nothing to prepare (whole implies with_depth).
   TaskPool::Task prepared;
-  if (with_depth && pool_ && pool_->threads() > 1) {
-    prepared = pool_->submit(prepare);
-  } else if (with_depth) {
-    prepare();
+  if (with_depth) {
+    if (pool_ && pool_->threads() > 1) {
+      prepared = pool_->submit(prepare);
+    } else {
+      prepare();
+    }
   }
   extract(sensor, out);
   prepared.wait();

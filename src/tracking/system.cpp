@@ -26,7 +26,7 @@ void SystemOptions::validate() const {
   map.validate();
   loop_closing.validate();
   require(!scan_time_offset || (std::isfinite(*scan_time_offset) && std::abs(*scan_time_offset) <= kMaxScanAge),
-          "scan_time_offset", "seconds from the scan to the image, -1 .. 1");
+          "scan_time_offset", kScanAgeExpected);
   require(std::isfinite(frame_period) && frame_period > 0.0, "frame_period", "seconds > 0");
 }
 

@@ -31,6 +31,8 @@ inline constexpr std::size_t kMaxScanPoints = 10'000'000;
 // Seconds between a scan and its image beyond which the two are not one trigger's (KITTI: 17 ms
 // apart): such a scan time is a glitch of the log, and the scan is taken as simultaneous.
 inline constexpr double kMaxScanAge = 1.0;
+// What a setting of that time must be (the settings key's and the options' message).
+inline constexpr const char* kScanAgeExpected = "seconds from the scan to the image, -1 .. 1";
 
 // Reads a KITTI .bin into `points` (reusing its capacity). Throws ParseError naming the file when it
 // is not a readable regular file, its size is not a multiple of 16 bytes or it holds more than
