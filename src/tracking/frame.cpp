@@ -77,6 +77,8 @@ void TrackerOptions::validate() const {
           "tracker.initial_reference_ratio_threshold", "in (0, 1]");
   require(urgent_reference_ratio >= 0.0 && urgent_reference_ratio <= 1.0, "tracker.urgent_reference_ratio",
           "in [0, 1] (0 = off)");
+  require(reference_landmark_ratio >= 0.0 && reference_landmark_ratio <= 1.0, "tracker.reference_landmark_ratio",
+          "in [0, 1] (0 = off)");
   require(close_depth > 0.0, "tracker.close_depth", "> 0");
   pose.validate();
 }

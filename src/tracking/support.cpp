@@ -30,7 +30,8 @@ bool keyframe_due(const KeyframeEvidence& e, const TrackerOptions& options) {
   const double ratio = e.keyframes < 2 ? options.initial_reference_ratio_threshold : options.reference_ratio_threshold;
   const bool c1a = e.frames_since_keyframe >= options.max_frames_between_keyframes;
   const bool c1c = e.established_inliers < options.urgent_reference_ratio * e.reference_established || need_close;
-  const bool c2 = (e.established_inliers < ratio * e.reference_established || need_close) &&
+  const bool thinned = e.inliers < options.reference_landmark_ratio * e.reference_landmarks;
+  const bool c2 = (e.established_inliers < ratio * e.reference_established || need_close || thinned) &&
                   e.inliers > options.min_keyframe_inliers;
   return (c1a || e.mapping_idle || c1c) && c2;
 }

@@ -940,6 +940,7 @@ bool Tracker::need_keyframe(const Frame& frame, int inliers, bool mapping_idle) 
   const int min_observations = keyframes <= 2 ? 2 : 3;
   const Keyframe* ref = map_.keyframe(reference_);
   e.reference_established = ref != nullptr ? ref->tracked_landmarks(min_observations, map_) : 0;
+  if (ref != nullptr && options_.reference_landmark_ratio > 0.0) e.reference_landmarks = ref->tracked_landmarks(1, map_);
   for (std::size_t i = 0; i < frame.size(); ++i) {
     const bool tracked = frame.landmarks[i].valid() && !frame.outlier[i];
     if (tracked) {

@@ -111,6 +111,19 @@ TEST_CASE("keyframe rule: like with like, established inliers against the refere
   e.inliers = 15;  // never on min_keyframe_inliers (15) inliers or fewer
   CHECK_FALSE(rgbl::keyframe_due(e, options));
 
+  // off by default (docs/accuracy.md, "Keyframes when all the reference's landmarks thin out"); at 0.25,
+  // where keyframes are sparse and few landmarks established: due once the frame tracks fewer than a
+  // quarter of all the reference's landmarks, however many of the few established it keeps
+  rgbl::KeyframeEvidence sparse{.keyframes = 2, .frames_since_keyframe = 20, .mapping_idle = false,
+                                .reference_established = 126, .reference_landmarks = 760, .inliers = 191,
+                                .established_inliers = 120, .tracked_close = 191, .untracked_close = 0};
+  rgbl::TrackerOptions thin = options;
+  thin.reference_landmark_ratio = 0.25;
+  CHECK_FALSE(rgbl::keyframe_due(sparse, thin));  // 191 of 760: more than 25 %
+  sparse.inliers = 189;                           // < 190
+  CHECK(rgbl::keyframe_due(sparse, thin));
+  CHECK_FALSE(rgbl::keyframe_due(sparse, options));  // off: the established rule alone waits
+
   // close points needed (< 100 tracked and > 70 untracked within close_depth): due at once
   rgbl::KeyframeEvidence close{.keyframes = 20, .frames_since_keyframe = 1, .mapping_idle = false,
                                .reference_established = 150, .inliers = 400, .established_inliers = 140,

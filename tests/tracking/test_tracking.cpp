@@ -125,6 +125,9 @@ TEST_CASE("system: configuration errors name the key, no depth keeps it uninitia
   verify = {};
   verify.urgent_reference_ratio = 1.5;
   CHECK_THROWS_WITH(verify.validate(), Catch::Contains("tracker.urgent_reference_ratio"));
+  verify = {};
+  verify.reference_landmark_ratio = -0.1;
+  CHECK_THROWS_WITH(verify.validate(), Catch::Contains("tracker.reference_landmark_ratio"));
 
   rgbl::OrbExtractor orb;
   rgbl::System system({}, small_camera(), std::make_unique<NoDepth>(),

@@ -36,6 +36,7 @@ struct KeyframeEvidence {
   int frames_since_keyframe = 0;
   bool mapping_idle = false;
   int reference_established = 0;  // the reference keyframe's landmarks seen by enough keyframes
+  int reference_landmarks = 0;    // all of the reference keyframe's landmarks still in the map
   int inliers = 0;                // the frame's inliers on landmarks...
   int established_inliers = 0;    // ...and those on landmarks seen by enough keyframes
   int tracked_close = 0, untracked_close = 0;  // keypoints with depth under close_depth
@@ -44,7 +45,8 @@ struct KeyframeEvidence {
 // ORB-SLAM3's RGB-D keyframe rule (SPEC 5) counted like with like: a keyframe is due when the frame
 // tracks fewer than reference_ratio_threshold (initial_reference_ratio_threshold while the map has
 // one keyframe) of the reference keyframe's established landmarks, counting only its own inliers on
-// established landmarks, or needs close points; and max_frames_between_keyframes have passed,
+// established landmarks, or needs close points, or tracks fewer than reference_landmark_ratio of all
+// the reference's landmarks (young ones too); and max_frames_between_keyframes have passed,
 // mapping is idle or it is urgent (urgent_reference_ratio); never on min_keyframe_inliers inliers or
 // fewer.
 bool keyframe_due(const KeyframeEvidence& e, const TrackerOptions& options);
