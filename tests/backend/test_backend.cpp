@@ -42,6 +42,7 @@ TEST_CASE("pose residual Jacobian matches numeric differentiation") {
   std::mt19937 rng(1);
   const auto points = scene(rng, T, 20);
   for (const bool with_depth : {false, true}) {
+   for (const bool bounded : {false, true}) {
     for (const auto& p : points) {
       rgbl::PoseObservation o;
       o.p_world = p;
@@ -54,7 +55,7 @@ TEST_CASE("pose residual Jacobian matches numeric differentiation") {
       Eigen::Vector3d r0, r1;
       Eigen::Matrix<double, 3, 6> J, unused;
       int dim = 0;
-      REQUIRE(rgbl::pose_residual(cam, T, o, r0, J, dim));
+      REQUIRE(rgbl::pose_residual(cam, T, o, r0, J, dim, bounded));
       CHECK(dim == (with_depth ? 3 : 2));
       const double h = 1e-6;
       Eigen::Matrix<double, 3, 6> numeric;
@@ -62,12 +63,18 @@ TEST_CASE("pose residual Jacobian matches numeric differentiation") {
         rgbl::Vector6d d = rgbl::Vector6d::Zero();
         d(k) = h;
         Eigen::Vector3d rp, rm;
-        rgbl::pose_residual(cam, rgbl::se3_exp(d) * T, o, rp, unused, dim);
-        rgbl::pose_residual(cam, rgbl::se3_exp(-d) * T, o, rm, unused, dim);
+        rgbl::pose_residual(cam, rgbl::se3_exp(d) * T, o, rp, unused, dim, bounded);
+        rgbl::pose_residual(cam, rgbl::se3_exp(-d) * T, o, rm, unused, dim, bounded);
         numeric.col(k) = (rp - rm) / (2.0 * h);
       }
       CHECK((numeric - J).norm() < 1e-4 * (1.0 + J.norm()));
+      // the bounded error is the metric one scaled by d / z
+      if (with_depth && bounded) {
+        const double z = (T * p).z();
+        CHECK(r0(2) == Approx((z - o.depth) * o.depth / z / o.depth_sigma).epsilon(1e-9));
+      }
     }
+   }
   }
  }
 }
@@ -138,6 +145,50 @@ TEST_CASE("pose optimisation recovers a known pose with noise and flags the outl
   CHECK(flagged == 60);
   CHECK(wrong < 24);  // chi2 at 95%: ~5% of the good ones fall outside
   CHECK(result.inliers == static_cast<int>(obs.size()) - flagged - wrong);
+}
+
+TEST_CASE("pose optimisation with the bounded depth error: a landmark far down its ray, matched to a keypoint with a near depth, is an outlier") {
+  // The case of sequence 04 (the reliability test's jump back): 77 true matches, 45 with depth, at the
+  // relocalisation's PnP pose, and one landmark that bundle adjustment had pushed 45.9 km down a
+  // near-parallel ray, matched to a keypoint whose LiDAR depth is 24.3 m. Its pixel is right; only
+  // its depth contradicts. Measured in metres (z - d, the default), that one residual outweighs the
+  // rest and sends the pose 34 m off with no inlier left; bounded ((z - d) d / z), it is an outlier.
+  const auto cam = rgbl::test::kitti_camera();
+  const Eigen::Isometry3d T_true = test_pose();
+  std::mt19937 rng(7);
+  const auto points = scene(rng, T_true, 77);
+  std::normal_distribution<double> px_noise(0.0, 1.0), z_noise(0.0, 0.1);
+  std::vector<rgbl::PoseObservation> obs;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    rgbl::PoseObservation o;
+    o.p_world = points[i];
+    const Eigen::Vector3d pc = T_true * points[i];
+    o.pixel = cam.project_unchecked(pc) + Eigen::Vector2d(px_noise(rng), px_noise(rng));
+    o.sigma_px = 2.0;
+    if (i % 7 < 4) {
+      o.depth = pc.z() + z_noise(rng);
+      o.depth_sigma = 0.1;
+    }
+    obs.push_back(o);
+  }
+  rgbl::PoseObservation far;
+  const Eigen::Vector2d pixel(cam.cx + 180.0, cam.cy - 40.0);
+  far.p_world = T_true.inverse() * cam.unproject(pixel, 45875.8);
+  far.pixel = pixel;
+  far.sigma_px = 2.0;
+  far.depth = 24.28;
+  far.depth_sigma = 0.153;
+  obs.push_back(far);
+  rgbl::Vector6d offset;
+  offset << 0.05, -0.03, 0.1, 0.002, 0.001, -0.002;  // a PnP pose: a few pixels off
+  rgbl::PoseOptimizerOptions options;
+  options.bounded_depth_error = true;
+  const auto result = rgbl::optimize_pose(cam, rgbl::se3_exp(offset) * T_true, obs, options);
+  const Eigen::Isometry3d E = result.T_cam_world * T_true.inverse();
+  CHECK(E.translation().norm() < 0.05);
+  CHECK(rgbl::rotation_angle(E.linear()) < 1e-3);
+  CHECK_FALSE(result.inlier.back());
+  CHECK(result.inliers >= 70);
 }
 
 TEST_CASE("depth noise model grows with depth and sample distance and rejects edges") {
