@@ -8,14 +8,6 @@ seconds="${1:-60}"
 RGBL_FUZZ=1 ./scripts/install-deps.sh
 cmake --preset fuzz
 cmake --build --preset fuzz
-# the build preset names the fuzzers (so that only the libraries they need are built): one left out there
-# would silently never run
-expected="$(ls fuzz/fuzz_*.cpp | wc -l)"
-built="$(ls build/fuzz/bin/fuzz_* | wc -l)"
-if [ "$built" -ne "$expected" ]; then
-  echo "fuzz: $built fuzzers built for $expected sources in fuzz/: add the new one to the targets of the fuzz build preset (CMakePresets.json)" >&2
-  exit 1
-fi
 scratch="$(mktemp -d)"
 trap 'rm -rf "$scratch"' EXIT
 status=0

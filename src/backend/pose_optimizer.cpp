@@ -35,20 +35,17 @@ bool pose_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_w
   jacobian = dproj * dp;
   jacobian.row(0) *= w;
   jacobian.row(1) *= w;
-  if (dimension == 3 && bounded_depth_error) {
-    // The depth error measured in inverse depth, scaled to metres at the measured depth d:
-    // (z - d) d / z, in sigmas. Near z = d it is the metric error z - d; as z grows it tends to d and
-    // its Jacobian to 0, as the disparity error of ORB-SLAM's RGB-D edge does. The plain z - d grows
-    // without bound: a landmark that bundle adjustment had pushed 45.9 km down a near-parallel ray,
-    // matched to a keypoint with a 24 m LiDAR depth, outweighed 77 true matches and sent the pose
-    // 40 m off (sequence 04, the relocalisation of the reliability test's jump).
-    const double wz = obs.depth / (obs.depth_sigma * p.z());
+  if (dimension == 3) {
+    // Bounded: the depth error measured in inverse depth, scaled to metres at the measured depth d,
+    // (z - d) s with s = d / z. Near z = d it is the metric error z - d; as z grows it tends to d and
+    // its Jacobian (d/dz = s^2) to 0, as the disparity error of ORB-SLAM's RGB-D edge does. The plain
+    // z - d grows without bound: a landmark that bundle adjustment had pushed 45.9 km down a
+    // near-parallel ray, matched to a keypoint with a 24 m LiDAR depth, outweighed 77 true matches and
+    // sent the pose 45 m off (sequence 04, the relocalisation of the reliability test's jump).
+    const double s = bounded_depth_error ? obs.depth / p.z() : 1.0;
+    const double wz = s / obs.depth_sigma;
     residual(2) = (p.z() - obs.depth) * wz;
-    jacobian.row(2) *= obs.depth * wz / p.z();  // d/dz [(z - d) d / z] = d^2 / z^2
-  } else if (dimension == 3) {
-    const double wz = 1.0 / obs.depth_sigma;
-    residual(2) = (p.z() - obs.depth) * wz;
-    jacobian.row(2) *= wz;
+    jacobian.row(2) *= s * wz;
   } else {
     residual(2) = 0.0;
     jacobian.row(2).setZero();

@@ -148,8 +148,8 @@ TEST_CASE("pose optimisation recovers a known pose with noise and flags the outl
 }
 
 TEST_CASE("pose optimisation with the bounded depth error: a landmark far down its ray, matched to a keypoint with a near depth, is an outlier") {
-  // The case of sequence 04 (the reliability test's jump back): 77 true matches, 45 with depth, at the
-  // relocalisation's PnP pose, and one landmark that bundle adjustment had pushed 45.9 km down a
+  // The case of sequence 04 (the reliability test's jump back): 77 true matches (here 44 with depth)
+  // at the relocalisation's PnP pose, and one landmark that bundle adjustment had pushed 45.9 km down a
   // near-parallel ray, matched to a keypoint whose LiDAR depth is 24.3 m. Its pixel is right; only
   // its depth contradicts. Measured in metres (z - d, the default), that one residual outweighs the
   // rest and sends the pose 34 m off with no inlier left; bounded ((z - d) d / z), it is an outlier.

@@ -37,8 +37,8 @@ rgbl::KittiLayout write_curve(const std::filesystem::path& root) {
   return rgbl::write_kitti(rgbl::SyntheticGenerator(o), root, 0);
 }
 
-// CTest runs each test case in a process of its own, and rendering the curve in each cost 3.5 s apiece
-// (25 s under ASan). So the fixture test below writes it once per CTest run into $RGBL_PIPELINE_CURVE,
+// CTest runs each test case in a process of its own, and rendering the curve in each cost 4.4 s apiece
+// (24 s under ASan). So the fixture test below writes it once per CTest run into $RGBL_PIPELINE_CURVE,
 // and every test reads it there; the binary run by hand renders its own into a temporary folder.
 const rgbl::KittiLayout& curve() {
   static std::optional<rgbl::test::TempDir> own;
