@@ -6,8 +6,11 @@
 # per run, the script prints both builds' mean ATE over the samples and how often B beat A.
 #
 #   scripts/ab-table.sh --a BUILD_DIR --b BUILD_DIR [--features "1800 ... 2200"] [--out DIR]
+#                       [--a-settings FILE] [--b-settings FILE]
 #                       [-- ARGS for scripts/accuracy.sh, e.g. --no-variants --scenarios "traffic"]
 #
+# --a-settings / --b-settings: settings keys (lines of a settings YAML, e.g. Tracking.BoundedDepthError: 1)
+# added to that side's runs, so one build can be compared with itself under another option.
 # Each build directory needs bin/rgbl and bin/rgbl_accuracy_table. With --no-variants one sample of
 # one build took 1.1-2.2 min here (2 cores, a CI run beside it): about 18 min for the defaults.
 set -euo pipefail
@@ -15,6 +18,8 @@ repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 a=""
 b=""
 features="1800 1900 2000 2100 2200"
+a_settings=""
+b_settings=""
 out="$repo/build/ab"
 suite=()
 while [ $# -gt 0 ]; do
@@ -22,9 +27,11 @@ while [ $# -gt 0 ]; do
     --a) a="$2"; shift 2 ;;
     --b) b="$2"; shift 2 ;;
     --features) features="$2"; shift 2 ;;
+    --a-settings) a_settings="$2"; shift 2 ;;
+    --b-settings) b_settings="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --) shift; suite=("$@"); break ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "ab-table: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -36,14 +43,20 @@ for build in "$a" "$b"; do
     [ -x "$build/bin/$tool" ] || { echo "ab-table: $build/bin/$tool not built" >&2; exit 2; }
   done
 done
+for f in "$a_settings" "$b_settings"; do
+  [ -z "$f" ] || [ -r "$f" ] || { echo "ab-table: cannot read the settings file '$f'" >&2; exit 2; }
+done
 mkdir -p "$out"
 for n in $features; do
   case "$n" in ''|*[!0-9]*) echo "ab-table: --features takes whole numbers, got '$n'" >&2; exit 2 ;; esac
-  config="$out/features-$n.yaml"
-  printf '%%YAML:1.0\nORBextractor.nFeatures: %d\n' "$n" > "$config"
   for side in a b; do
     build="$a"
-    [ "$side" = b ] && build="$b"
+    settings="$a_settings"
+    [ "$side" = b ] && build="$b" && settings="$b_settings"
+    config="$out/$side-features-$n.yaml"
+    printf '%%YAML:1.0\nORBextractor.nFeatures: %d\n' "$n" > "$config"
+    # the side's own keys, without their file's YAML header
+    [ -z "$settings" ] || grep -v '^%YAML' "$settings" >> "$config"
     echo "ab-table: nFeatures $n, build $side ($build)"
     # each sample's figures are saved for the summary
     "$repo/scripts/accuracy.sh" --build "$build" --out "$out/$side-$n" --no-baseline \

@@ -384,6 +384,10 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.loop_closing.global_ba = flag("LoopClosing.GlobalBA");
   s.loop_closing.merge_maps = flag("LoopClosing.MergeMaps");
   s.place_culling = flag("LocalMapping.PlaceCulling");
+  s.reference_landmark_ratio = r.number({"Tracking.ReferenceLandmarkRatio"});
+  if (s.reference_landmark_ratio && !(*s.reference_landmark_ratio >= 0.0 && *s.reference_landmark_ratio <= 1.0))
+    r.fail("Tracking.ReferenceLandmarkRatio", "a share from 0 (off) to 1");
+  s.bounded_depth_error = flag("Tracking.BoundedDepthError");
 
   if (!(s.projection.min_depth >= 0.0F)) r.fail("LiDAR.min_dist", "a distance >= 0 m");
   if (!(s.projection.max_depth > s.projection.min_depth))

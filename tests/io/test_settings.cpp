@@ -206,6 +206,23 @@ TEST_CASE("settings: LocalMapping.PlaceCulling switches keyframe culling by revi
              Contains("'LocalMapping.PlaceCulling': expected 0 (off) or 1 (on)"));
 }
 
+TEST_CASE("settings: Tracking.* keys reach the tracker's keyframe rule and pose refinement", "[io][settings]") {
+  rgbl::test::TempDir tmp;
+  const auto s = rgbl::read_settings(
+      tmp.write("t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0.25\nTracking.BoundedDepthError: 1\n"));
+  REQUIRE(s.reference_landmark_ratio);
+  CHECK(*s.reference_landmark_ratio == 0.25);
+  CHECK(s.bounded_depth_error == true);
+  CHECK(s.warnings.empty());
+  const auto unset = rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n"));
+  CHECK_FALSE(unset.reference_landmark_ratio);
+  CHECK_FALSE(unset.bounded_depth_error);
+  CHECK_THAT(error_of(tmp.write("ratio.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 1.5\n")),
+             Contains("'Tracking.ReferenceLandmarkRatio': expected a share from 0 (off) to 1"));
+  CHECK_THAT(error_of(tmp.write("flag.yaml", "%YAML:1.0\nTracking.BoundedDepthError: 2\n")),
+             Contains("'Tracking.BoundedDepthError': expected 0 (off) or 1 (on)"));
+}
+
 TEST_CASE("settings: wrong types, incomplete groups and bad values name file and key", "[io][settings][bad-input]") {
   rgbl::test::TempDir tmp;
   CHECK_THAT(error_of(tmp.write("a.yaml", replace(kRgblYaml, "LiDAR.min_dist: 5.0", "LiDAR.min_dist: \"five\""))),

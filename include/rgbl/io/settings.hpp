@@ -12,6 +12,8 @@
 //   rgbl's own LiDAR.OcclusionWindowDeg (0 = off), LiDAR.OcclusionRatio (LidarSourceOptions::occlusion_*),
 //   LiDAR.TimeOffset (SystemOptions::scan_time_offset: the image's time minus the scan's, seconds;
 //   overrides the dataset's scan timestamps, 0 = simultaneous),
+//   rgbl's own Tracking.ReferenceLandmarkRatio (TrackerOptions::reference_landmark_ratio, 0..1) and
+//   Tracking.BoundedDepthError (0/1, PoseOptimizerOptions::bounded_depth_error of the tracker),
 //   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
 //   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1), MergeMaps (0/1) (LoopClosingOptions' fields of those
 //   names).
@@ -78,6 +80,8 @@ struct Settings {
   std::optional<double> scan_time_offset;      // LiDAR.TimeOffset, s; unset = the dataset's scan timestamps
   LoopClosingSettings loop_closing;
   std::optional<bool> place_culling;  // LocalMapping.PlaceCulling: keyframe culling by revisits
+  std::optional<double> reference_landmark_ratio;  // Tracking.ReferenceLandmarkRatio
+  std::optional<bool> bounded_depth_error;          // Tracking.BoundedDepthError
   std::vector<std::string> warnings;  // unknown keys, one message each
 };
 
