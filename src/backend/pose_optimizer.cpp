@@ -4,6 +4,7 @@
 
 #include <Eigen/Cholesky>
 
+#include <algorithm>
 #include <cmath>
 
 namespace rgbl {
@@ -36,13 +37,14 @@ bool pose_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_w
   jacobian.row(0) *= w;
   jacobian.row(1) *= w;
   if (dimension == 3) {
-    // Bounded: the depth error measured in inverse depth, scaled to metres at the measured depth d,
-    // (z - d) s with s = d / z. Near z = d it is the metric error z - d; as z grows it tends to d and
-    // its Jacobian (d/dz = s^2) to 0, as the disparity error of ORB-SLAM's RGB-D edge does. The plain
-    // z - d grows without bound: a landmark that bundle adjustment had pushed 45.9 km down a
-    // near-parallel ray, matched to a keypoint with a 24 m LiDAR depth, outweighed 77 true matches and
-    // sent the pose 45 m off (sequence 04, the relocalisation of the reliability test's jump).
-    const double s = bounded_depth_error ? obs.depth / p.z() : 1.0;
+    // Bounded: beyond the measured depth d the error is measured in inverse depth, scaled to metres at
+    // d: (z - d) s with s = d / z, which tends to d as z grows while its Jacobian (d/dz = s^2) tends to
+    // 0, as the disparity error of ORB-SLAM's RGB-D edge does. Nearer than d it stays metric (s = 1; the
+    // error is then bounded by d anyway), so the two meet with equal slope at z = d. The plain z - d
+    // grows without bound: a landmark that bundle adjustment had pushed 45.9 km down a near-parallel
+    // ray, matched to a keypoint with a 24 m LiDAR depth, outweighed 77 true matches and sent the pose
+    // 45 m off (sequence 04, the relocalisation of the reliability test's jump).
+    const double s = bounded_depth_error ? std::min(1.0, obs.depth / p.z()) : 1.0;
     const double wz = s / obs.depth_sigma;
     residual(2) = (p.z() - obs.depth) * wz;
     jacobian.row(2) *= s * wz;

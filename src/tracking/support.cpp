@@ -24,6 +24,18 @@ TrackState support_state(int inliers, std::optional<std::size_t> frames_since_re
   return inliers >= needed ? TrackState::Ok : TrackState::Weak;
 }
 
+bool motion_suspect(const MotionEvidence& e, const TrackerOptions& options) {
+  const double floor = options.min_pose_inliers;
+  const double found_needed = options.verify_min_found_ratio * e.local_visible;
+  const double offered = e.last_keypoints > 0
+                             ? std::min(1.0, static_cast<double>(e.keypoints) / static_cast<double>(e.last_keypoints))
+                             : 1.0;
+  const double motion_needed = options.verify_min_motion_ratio * e.last_inliers * offered;
+  const bool map_disagrees = found_needed >= floor && e.local_inliers < found_needed;
+  const bool motion_collapsed = motion_needed >= floor && e.motion_inliers < motion_needed;
+  return map_disagrees || motion_collapsed;
+}
+
 bool keyframe_due(const KeyframeEvidence& e, const TrackerOptions& options) {
   const bool need_close =
       e.tracked_close < options.close_tracked_threshold && e.untracked_close > options.close_untracked_threshold;

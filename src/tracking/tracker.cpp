@@ -236,7 +236,7 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
                       first.local.inliers, first.local.visible);
       ok = h.relocalised = false;
     }
-    first.suspect = first.motion_ok && suspect(first.motion_inliers, first.local);
+    first.suspect = first.motion_ok && suspect(first.motion_inliers, first.local, frame.size());
     if (!ok && first.motion_ok && options_.keep_weak_tracking && !first.suspect) {
       // The map is thin here (e.g. mapping lags behind) but frame-to-frame motion held: keep the
       // motion-model pose and refresh the map with a keyframe instead of declaring the camera lost.
@@ -496,16 +496,15 @@ TrackerOutcome& Tracker::finish_initialised(const Frame& frame, TrackerOutcome& 
   return outcome;
 }
 
-bool Tracker::suspect(int motion_inliers, const LocalMapResult& local) const {
-  // A check judges only where passing it means at least min_pose_inliers points: a local map or a
-  // last frame thinner than that is mapping lagging behind (threaded mode) or the weak-tracking
-  // fallback, and says nothing about the pose.
-  const double floor = options_.min_pose_inliers;
-  const double found_needed = options_.verify_min_found_ratio * local.visible;
-  const double motion_needed = options_.verify_min_motion_ratio * last_inliers_;
-  const bool map_disagrees = found_needed >= floor && local.inliers < found_needed;
-  const bool motion_collapsed = motion_needed >= floor && motion_inliers < motion_needed;
-  return map_disagrees || motion_collapsed;
+bool Tracker::suspect(int motion_inliers, const LocalMapResult& local, std::size_t keypoints) const {
+  MotionEvidence e;
+  e.motion_inliers = motion_inliers;
+  e.last_inliers = last_inliers_;
+  e.keypoints = keypoints;
+  e.last_keypoints = last_frame_ ? last_frame_->size() : 0;
+  e.local_inliers = local.inliers;
+  e.local_visible = local.visible;
+  return motion_suspect(e, options_);
 }
 
 bool Tracker::within_reach(const Frame& frame, const Prediction& prediction) const {

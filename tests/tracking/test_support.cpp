@@ -111,18 +111,19 @@ TEST_CASE("keyframe rule: like with like, established inliers against the refere
   e.inliers = 15;  // never on min_keyframe_inliers (15) inliers or fewer
   CHECK_FALSE(rgbl::keyframe_due(e, options));
 
-  // off by default (docs/accuracy.md, "Keyframes when all the reference's landmarks thin out"); at 0.25,
-  // where keyframes are sparse and few landmarks established: due once the frame tracks fewer than a
-  // quarter of all the reference's landmarks, however many of the few established it keeps
+  // 0.25 by default (docs/accuracy.md, "Keyframes when all the reference's landmarks thin out"): where
+  // keyframes are sparse and few landmarks established, due once the frame tracks fewer than a quarter
+  // of all the reference's landmarks, however many of the few established it keeps
   rgbl::KeyframeEvidence sparse{.keyframes = 2, .frames_since_keyframe = 20, .mapping_idle = false,
                                 .reference_established = 126, .reference_landmarks = 760, .inliers = 191,
                                 .established_inliers = 120, .tracked_close = 191, .untracked_close = 0};
-  rgbl::TrackerOptions thin = options;
-  thin.reference_landmark_ratio = 0.25;
-  CHECK_FALSE(rgbl::keyframe_due(sparse, thin));  // 191 of 760: more than 25 %
-  sparse.inliers = 189;                           // < 190
-  CHECK(rgbl::keyframe_due(sparse, thin));
-  CHECK_FALSE(rgbl::keyframe_due(sparse, options));  // off: the established rule alone waits
+  REQUIRE(options.reference_landmark_ratio == 0.25);
+  CHECK_FALSE(rgbl::keyframe_due(sparse, options));  // 191 of 760: more than 25 %
+  sparse.inliers = 189;                              // < 190
+  CHECK(rgbl::keyframe_due(sparse, options));
+  rgbl::TrackerOptions off = options;
+  off.reference_landmark_ratio = 0.0;
+  CHECK_FALSE(rgbl::keyframe_due(sparse, off));  // off: the established rule alone waits
 
   // close points needed (< 100 tracked and > 70 untracked within close_depth): due at once
   rgbl::KeyframeEvidence close{.keyframes = 20, .frames_since_keyframe = 1, .mapping_idle = false,
@@ -139,4 +140,54 @@ TEST_CASE("keyframe rule: like with like, established inliers against the refere
   CHECK_FALSE(rgbl::keyframe_due(second, options));
   second.established_inliers = 39;
   CHECK(rgbl::keyframe_due(second, options));
+}
+
+TEST_CASE("support: the motion model is suspect when the map or the recent frames disagree with it",
+          "[tracking][support]") {
+  const rgbl::TrackerOptions options;  // 5 % of the local map, 20 % of the last frame's inliers
+  REQUIRE(options.min_pose_inliers == 10);
+  rgbl::MotionEvidence e;
+  e.motion_inliers = 150;
+  e.last_inliers = 160;
+  e.keypoints = e.last_keypoints = 1950;
+  e.local_inliers = 200;
+  e.local_visible = 1000;
+  CHECK_FALSE(rgbl::motion_suspect(e, options));
+  SECTION("a jump onto a repetitive road: both checks fire") {
+    // sequence 04, frame 35 fed after 14: the motion model keeps 22 of 160, the local map 31 of 1000
+    e.motion_inliers = 22;
+    CHECK(rgbl::motion_suspect(e, options));  // 22 < 32
+    e.motion_inliers = 32;
+    CHECK_FALSE(rgbl::motion_suspect(e, options));
+    e.local_inliers = 31;
+    CHECK(rgbl::motion_suspect(e, options));  // 31 < 50
+    e.local_inliers = 50;
+    CHECK_FALSE(rgbl::motion_suspect(e, options));
+  }
+  SECTION("a frame on plain surfaces offers fewer keypoints: the yardstick shrinks with them") {
+    e.last_inliers = 552;
+    e.motion_inliers = 101;
+    CHECK(rgbl::motion_suspect(e, options));  // 101 < 110.4 with as many keypoints as the last frame
+    e.keypoints = 1100;                       // 110.4 * 1100 / 1950 = 62.3
+    CHECK_FALSE(rgbl::motion_suspect(e, options));
+    e.motion_inliers = 62;
+    CHECK(rgbl::motion_suspect(e, options));
+    // more keypoints than the last frame never raise the bar
+    e.keypoints = 3900;
+    e.motion_inliers = 111;
+    CHECK_FALSE(rgbl::motion_suspect(e, options));
+  }
+  SECTION("each check judges only where passing means min_pose_inliers points") {
+    e.last_inliers = 45;  // 20 % is 9 < 10: mapping lagging behind, no judgement
+    e.motion_inliers = 0;
+    CHECK_FALSE(rgbl::motion_suspect(e, options));
+    e.last_inliers = 0;  // the last frame was not tracked
+    CHECK_FALSE(rgbl::motion_suspect(e, options));
+    e.local_visible = 150;  // 5 % is 7.5 < 10
+    e.local_inliers = 0;
+    CHECK_FALSE(rgbl::motion_suspect(e, options));
+    e.last_keypoints = 0;  // no last frame: the share is taken as 1
+    e.last_inliers = 160;
+    CHECK(rgbl::motion_suspect(e, options));
+  }
 }

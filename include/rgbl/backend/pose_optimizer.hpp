@@ -33,10 +33,10 @@ struct PoseOptimizerOptions {
   // threshold fades (weight 1 / (1 + e^2 / c^2)).
   bool cauchy = false;
   double min_depth = 1e-3;     // points closer than this to the camera plane are outliers
-  // The depth error as (z - d) d / z (bounded by d as z grows, as ORB-SLAM's disparity error is) instead
-  // of z - d. Off: it fixes the relocalisation of docs/accuracy.md ("Keyframes when all the
-  // reference's landmarks thin out"), but on by default traffic seed 3's first 20 frames came out over
-  // 0.26 m in 3 of the 4 nFeatures samples its CLI test ran.
+  // The depth error beyond the measured depth d as (z - d) d / z (bounded by d as z grows, as ORB-SLAM's
+  // disparity error is) instead of z - d; nearer than d it is z - d either way. It fixes the
+  // relocalisation of docs/accuracy.md ("Keyframes when all the reference's landmarks thin out").
+  // The tracker turns it on (TrackerOptions::pose); off here for the other callers.
   bool bounded_depth_error = false;
 
   void validate() const;
@@ -51,7 +51,7 @@ struct PoseOptimizerResult {
 
 // Residual of one observation at pose T_cam_world, whitened by its sigmas: 2 or 3 entries
 // (u, v, then the depth error when the observation has depth: z - d, or with bounded_depth_error
-// (z - d) d / z, metric near the measured depth d and bounded by d for a point far beyond it).
+// (z - d) min(1, d / z), metric up to the measured depth d and bounded by d for a point far beyond it).
 // jacobian (rows as residual) is with respect to a left perturbation T <- exp(xi) * T, xi = [rho; phi].
 // Returns false when the point is behind.
 bool pose_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world, const PoseObservation& obs,

@@ -43,7 +43,8 @@ struct TrackerOptions {
   // Verification of the motion-model hypothesis (a jump in the input lands on a repetitive road that
   // the map "explains" from a pose tens of metres off). It is suspect when the local-map search re-finds
   // fewer than verify_min_found_ratio of the local-map points predicted visible, or the motion model
-  // keeps fewer than verify_min_motion_ratio of the last frame's inliers (0 = that check off). Each
+  // keeps fewer than verify_min_motion_ratio of the last frame's inliers, scaled down by the share of
+  // its keypoint count the frame has where that is smaller (0 = that check off). Each
   // judges only where passing means at least min_pose_inliers points (a thinner local map or last
   // frame is mapping lagging behind, as in threaded mode, and says nothing about the pose). A suspect
   // frame is relocalised against the whole map and the hypothesis with more local-map inliers is kept;
@@ -160,10 +161,11 @@ struct TrackerOptions {
   // landmarks still in the map, young ones too. Landmarks become established only as keyframes see
   // them, so where keyframes are sparse few are, and their count alone misses the frame leaving the
   // reference's view (the simulator's traffic street without its vehicles: 3 keyframes in 80 frames,
-  // tracked on 130-190 of ~1150 keypoints with depth). 0.25 is better on the stress scenarios and the
-  // loops and the same on the real drives, but its denser maps break two relocalisation rules, so it
-  // is off by default: docs/accuracy.md, "Keyframes when all the reference's landmarks thin out".
-  double reference_landmark_ratio = 0.0;
+  // tracked on 130-190 of ~1150 keypoints with depth). ORB-SLAM's urgent share for depth cameras,
+  // untuned: over five samples of the accuracy suite 0.82x the stress scenarios' ATE, the plain street
+  // and the real drives as before, both long loops under 0.10 m (docs/accuracy.md, "Keyframes when
+  // all the reference's landmarks thin out").
+  double reference_landmark_ratio = 0.25;
   int close_tracked_threshold = 100, close_untracked_threshold = 70;
   int min_keyframe_inliers = 15;
   // Threaded mapping: no keyframe while this many wait for local mapping (ORB-SLAM's 3). Without the
@@ -172,7 +174,9 @@ struct TrackerOptions {
   int max_queued_keyframes = 3;
   double close_depth = 97.0;            // m; "close" points (RGB-L: bf/fx * ThDepth = 100/707 * 700)
 
-  PoseOptimizerOptions pose;
+  // The depth error bounded beyond the measured depth: denser maps hold landmarks that bundle
+  // adjustment pushed far down near-parallel rays, whose metric depth error would outweigh every true match.
+  PoseOptimizerOptions pose{.bounded_depth_error = true};
 
   void validate() const;
 };

@@ -51,6 +51,26 @@ struct KeyframeEvidence {
 // fewer.
 bool keyframe_due(const KeyframeEvidence& e, const TrackerOptions& options);
 
+// What the check of the motion-model hypothesis looks at (TrackerOptions::verify_min_found_ratio and
+// verify_min_motion_ratio).
+struct MotionEvidence {
+  int motion_inliers = 0;             // inliers the motion model kept
+  int last_inliers = 0;               // the last frame's, 0 when it was not tracked
+  std::size_t keypoints = 0;          // the frame's
+  std::size_t last_keypoints = 0;     // the last frame's
+  int local_inliers = 0;              // local-map points the search re-found...
+  int local_visible = 0;              // ...of those predicted visible
+};
+
+// The motion-model pose disagrees with the map (the local-map search re-finds fewer than
+// verify_min_found_ratio of the points predicted visible) or with the recent frames (it keeps fewer
+// than verify_min_motion_ratio of the last frame's inliers, scaled by the share of the last frame's
+// keypoint count this frame has where that is below 1: a frame on plain surfaces, where the extractor
+// finds fewer, can keep only as many fewer at the right pose; a wrong pose leaves the count as it is).
+// Each check judges only where passing it means at least min_pose_inliers points: a thinner local map
+// or last frame is mapping lagging behind or the weak-tracking fallback, and says nothing of the pose.
+bool motion_suspect(const MotionEvidence& e, const TrackerOptions& options);
+
 // How far (m) a camera centre may end up from the constant-velocity prediction of a step of
 // predicted_step_m over dt seconds: step_tolerance + step_tolerance_relative * step + max_acceleration
 // * dt^2 / 2 (dt <= 0: unknown, the acceleration term left out).

@@ -160,8 +160,9 @@ class Tracker {
                                  ViewLog& views) const;
   // The keyframes sharing points with the frame and their neighbours; the caller holds the map lock.
   std::pair<std::vector<KeyframeId>, KeyframeId> local_map_around(const Frame& frame, KeyframeId reference) const;
-  // The motion-model hypothesis disagrees with the map or with the recent frames (see TrackerOptions).
-  bool suspect(int motion_inliers, const LocalMapResult& local) const;
+  // The motion-model hypothesis disagrees with the map or with the recent frames (motion_suspect);
+  // keypoints: how many the frame has.
+  bool suspect(int motion_inliers, const LocalMapResult& local, std::size_t keypoints) const;
   bool relocalise(Frame& frame) const;
   // The local-map search from a relocalised pose re-finds enough of the points it predicts visible.
   bool relocalisation_confirmed(const LocalMapResult& local) const;
