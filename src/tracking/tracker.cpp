@@ -497,14 +497,13 @@ TrackerOutcome& Tracker::finish_initialised(const Frame& frame, TrackerOutcome& 
 }
 
 bool Tracker::suspect(int motion_inliers, const LocalMapResult& local, std::size_t keypoints) const {
-  MotionEvidence e;
-  e.motion_inliers = motion_inliers;
-  e.last_inliers = last_inliers_;
-  e.keypoints = keypoints;
-  e.last_keypoints = last_frame_ ? last_frame_->size() : 0;
-  e.local_inliers = local.inliers;
-  e.local_visible = local.visible;
-  return motion_suspect(e, options_);
+  return motion_suspect({.motion_inliers = motion_inliers,
+                         .last_inliers = last_inliers_,
+                         .keypoints = keypoints,
+                         .last_keypoints = last_frame_ ? last_frame_->size() : 0,
+                         .local_inliers = local.inliers,
+                         .local_visible = local.visible},
+                        options_);
 }
 
 bool Tracker::within_reach(const Frame& frame, const Prediction& prediction) const {

@@ -206,7 +206,7 @@ TEST_CASE("settings: LocalMapping.PlaceCulling switches keyframe culling by revi
              Contains("'LocalMapping.PlaceCulling': expected 0 (off) or 1 (on)"));
 }
 
-TEST_CASE("settings: Tracking.* keys reach the tracker's keyframe rule and pose refinement", "[io][settings]") {
+TEST_CASE("settings: Tracking.ReferenceLandmarkRatio and Tracking.BoundedDepthError, read and validated", "[io][settings]") {
   rgbl::test::TempDir tmp;
   const auto s = rgbl::read_settings(
       tmp.write("t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0.25\nTracking.BoundedDepthError: 1\n"));

@@ -179,6 +179,18 @@ TEST_CASE("the settings file's LiDAR.TimeOffset reaches the system, overriding t
   CHECK_THROWS_WITH(bad.validate(), Contains("scan_time_offset"));
 }
 
+TEST_CASE("the settings file's Tracking keys reach the tracker") {
+  rgbl::test::TempDir dir;
+  auto o = options();
+  const rgbl::TrackerOptions defaults = rgbl::Pipeline(o).system_options().tracker;
+  CHECK(defaults.reference_landmark_ratio == 0.25);
+  CHECK(defaults.pose.bounded_depth_error);
+  o.settings = dir.write("t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0\nTracking.BoundedDepthError: 0\n");
+  const rgbl::TrackerOptions set = rgbl::Pipeline(o).system_options().tracker;
+  CHECK(set.reference_landmark_ratio == 0.0);
+  CHECK_FALSE(set.pose.bounded_depth_error);
+}
+
 TEST_CASE("a run that tracks nothing says so in its metrics: no figure for tracked frames") {
   // 100 features leave fewer keypoints with depth than initialisation needs: no frame is tracked
   rgbl::test::TempDir dir;

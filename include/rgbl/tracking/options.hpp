@@ -162,7 +162,7 @@ struct TrackerOptions {
   // them, so where keyframes are sparse few are, and their count alone misses the frame leaving the
   // reference's view (the simulator's traffic street without its vehicles: 3 keyframes in 80 frames,
   // tracked on 130-190 of ~1150 keypoints with depth). ORB-SLAM's urgent share for depth cameras,
-  // untuned: over five samples of the accuracy suite 0.82x the stress scenarios' ATE, the plain street
+  // untuned: over five samples of the accuracy suite 0.81x the stress scenarios' ATE, the plain street
   // and the real drives as before, both long loops under 0.10 m (docs/accuracy.md, "Keyframes when
   // all the reference's landmarks thin out").
   double reference_landmark_ratio = 0.25;
