@@ -68,7 +68,10 @@ def main():
     runs = sorted(set.intersection(*(set(t) for t in a + b)))
     if not runs:
         sys.exit("ab_table: no run is in every sample")
+    left_out = sorted(set.union(*(set(t) for t in a + b)) - set(runs))
     print(f"ATE RMSE in m over {len(samples)} samples (ORBextractor.nFeatures {', '.join(samples)})\n")
+    if left_out:
+        print(f"Left out, not in every sample of both sides: {', '.join(left_out)}\n")
     print("| run | A mean | B mean | B / A | B better in | A samples | B samples |")
     print("|---|---|---|---|---|---|---|")
     ratios = {}
