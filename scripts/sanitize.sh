@@ -13,6 +13,11 @@
 # 91 s at -O2, 52 s at -O1, 38 s without the two checks. With the research tools left out too
 # (RGBL_BUILD_TOOLS=OFF) the ASan build took 1837 CPU-seconds instead of 3657 (2026-12-01), and its
 # longest tests ran faster, not slower (the 400-frame loop 329 -> 282 s, map merging 240 -> 213 s).
+# Both presets are unity builds (CMAKE_UNITY_BUILD: a target's sources compiled in batches of 8, so
+# Eigen's, OpenCV's and Ceres's headers and templates are compiled once per batch, not per file). The
+# ASan build (2026-12-02, same sources): 1845 -> ~1260 CPU-seconds, 15.6 -> 10.8 min. So names in one
+# source file's anonymous namespace must not clash with another file's of the same target; this is
+# the build where a clash shows.
 #
 # Two things have made TSan binaries crash at start-up (SIGSEGV before main):
 # - ifunc resolvers instrumented by GCC (target_clones in src/depth/completion.cpp): the loader runs

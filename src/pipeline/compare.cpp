@@ -17,10 +17,13 @@ namespace rgbl {
 namespace {
 
 using detail::Json;
-constexpr auto number = detail::json_number;
+using detail::json_number;
 
 Json stats_json(const ErrorStats& s) {
-  return {{"rmse", number(s.rmse)}, {"mean", number(s.mean)}, {"median", number(s.median)}, {"max", number(s.max)}};
+  return {{"rmse", json_number(s.rmse)},
+          {"mean", json_number(s.mean)},
+          {"median", json_number(s.median)},
+          {"max", json_number(s.max)}};
 }
 
 }  // namespace
@@ -153,25 +156,26 @@ std::string comparison_json(const TrajectoryComparison& c) {
   for (const auto& l : e.kitti.per_length) {
     per_length.push_back({{"length", l.length},
                           {"segments", l.segments},
-                          {"t_err_percent", number(l.t_err_percent)},
-                          {"r_err_deg_per_100m", number(l.r_err_deg_per_100m)}});
+                          {"t_err_percent", json_number(l.t_err_percent)},
+                          {"r_err_deg_per_100m", json_number(l.r_err_deg_per_100m)}});
   }
   const Json json = {{"estimate", c.estimate.generic_string()},
                      {"ground_truth", c.ground_truth.generic_string()},
                      {"format", c.format},
                      {"poses", e.poses},
-                     {"path_length_m", number(e.path_length)},
+                     {"path_length_m", json_number(e.path_length)},
                      {"kitti",
                       {{"lengths_m", e.kitti_options.lengths},
                        {"step_frames", e.kitti_options.step_size},
                        {"segments", e.kitti.segments},
-                       {"t_err_percent", number(e.kitti.t_err_percent)},
-                       {"r_err_deg_per_100m", number(e.kitti.r_err_deg_per_100m)},
+                       {"t_err_percent", json_number(e.kitti.t_err_percent)},
+                       {"r_err_deg_per_100m", json_number(e.kitti.r_err_deg_per_100m)},
                        {"per_length", per_length}}},
                      {"ate_m", stats_json(e.ate.translation)},
                      {"rpe_translation_m", stats_json(e.rpe.translation)},
                      {"rpe_rotation_deg", stats_json(e.rpe.rotation_deg)},
-                     {"drift", {{"end_error_m", number(e.drift.end_error)}, {"percent", number(e.drift.percent)}}}};
+                     {"drift",
+                      {{"end_error_m", json_number(e.drift.end_error)}, {"percent", json_number(e.drift.percent)}}}};
   // a path that is not UTF-8 is written with replacement characters rather than failing the report
   return json.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }

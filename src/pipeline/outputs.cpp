@@ -20,10 +20,13 @@ namespace rgbl {
 namespace {
 
 using detail::Json;
-constexpr auto number = detail::json_number;
+using detail::json_number;
 
 Json stage(const StageStats& s) {
-  return {{"median", number(s.median)}, {"p95", number(s.p95)}, {"mean", number(s.mean)}, {"max", number(s.max)}};
+  return {{"median", json_number(s.median)},
+          {"p95", json_number(s.p95)},
+          {"mean", json_number(s.mean)},
+          {"max", json_number(s.max)}};
 }
 
 Json closure_json(const LoopClosure& c) {
@@ -31,42 +34,42 @@ Json closure_json(const LoopClosure& c) {
           {"matched_frame", c.matched_frame_index},
           {"merge", c.merged},
           {"place", c.place_source},
-          {"place_similarity", number(c.place_similarity)},
+          {"place_similarity", json_number(c.place_similarity)},
           {"inliers", c.inliers},
-          {"correction_m", number(c.correction_m)},
-          {"correction_deg", number(c.correction_deg)},
-          {"loop_error_before_m", number(c.correction.loop_error_before_m)},
-          {"loop_error_after_m", number(c.correction.loop_error_after_m)},
+          {"correction_m", json_number(c.correction_m)},
+          {"correction_deg", json_number(c.correction_deg)},
+          {"loop_error_before_m", json_number(c.correction.loop_error_before_m)},
+          {"loop_error_after_m", json_number(c.correction.loop_error_after_m)},
           {"fused_landmarks", c.fused_landmarks},
           {"global_ba",
            {{"keyframes", c.global_ba_keyframes},
             {"held", c.global_ba_held},
             {"landmarks", c.global_ba_landmarks},
             {"outliers", c.global_ba_outliers},
-            {"time_ms", number(c.global_ba_ms)}}},
-          {"time_ms", number(c.time_ms)}};
+            {"time_ms", json_number(c.global_ba_ms)}}},
+          {"time_ms", json_number(c.time_ms)}};
 }
 
 Json metrics_json(const RunMetrics& m) {
   const TrajectoryEvaluation& e = m.evaluation;
-  const Json tracked = m.tracked_ate ? Json{{"ate_rmse_m", number(m.tracked_ate->translation.rmse)},
-                                             {"ate_max_m", number(m.tracked_ate->translation.max)}}
+  const Json tracked = m.tracked_ate ? Json{{"ate_rmse_m", json_number(m.tracked_ate->translation.rmse)},
+                                             {"ate_max_m", json_number(m.tracked_ate->translation.max)}}
                                      : Json(nullptr);
   return {{"frames_with_ground_truth", m.frames_with_ground_truth},
           {"frames_tracked", m.frames_tracked},
           {"tracked", tracked},  // ATE over the tracked frames alone; the figures below cover every frame
-          {"path_length_m", number(e.path_length)},
-          {"ate_rmse_m", number(e.ate.translation.rmse)},
-          {"ate_max_m", number(e.ate.translation.max)},
-          {"end_point_drift_m", number(e.drift.end_error)},
-          {"end_point_drift_percent", number(e.drift.percent)},
-          {"rpe_translation_rmse_m", number(e.rpe.translation.rmse)},
-          {"rpe_rotation_rmse_deg", number(e.rpe.rotation_deg.rmse)},
+          {"path_length_m", json_number(e.path_length)},
+          {"ate_rmse_m", json_number(e.ate.translation.rmse)},
+          {"ate_max_m", json_number(e.ate.translation.max)},
+          {"end_point_drift_m", json_number(e.drift.end_error)},
+          {"end_point_drift_percent", json_number(e.drift.percent)},
+          {"rpe_translation_rmse_m", json_number(e.rpe.translation.rmse)},
+          {"rpe_rotation_rmse_deg", json_number(e.rpe.rotation_deg.rmse)},
           {"kitti",
            {{"lengths", m.kitti_lengths},
             {"segments", e.kitti.segments},
-            {"t_err_percent", number(e.kitti.t_err_percent)},
-            {"r_err_deg_per_100m", number(e.kitti.r_err_deg_per_100m)}}}};
+            {"t_err_percent", json_number(e.kitti.t_err_percent)},
+            {"r_err_deg_per_100m", json_number(e.kitti.r_err_deg_per_100m)}}}};
 }
 
 void write_text(const std::filesystem::path& file, const std::string& text) {
@@ -167,18 +170,19 @@ std::string summary_json(const RunResult& run) {
   j["rejected_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_rejected; });
   j["min_inliers_ok"] = min_inliers ? Json(*min_inliers) : Json(nullptr);
   const auto scan_age = run.scan_age_median();
-  j["scan_to_image_ms"] = scan_age ? Json(number(*scan_age * 1000.0)) : Json(nullptr);  // median; 0: simultaneous
+  j["scan_to_image_ms"] = scan_age ? Json(json_number(*scan_age * 1000.0)) : Json(nullptr);  // median; 0: simultaneous
   j["keyframes"] = run.keyframe_count();
   j["landmarks"] = run.landmarks.size();
   j["loop_closing"] = run.loop_closing;
   j["loop_closures"] = std::move(closures);
-  j["loop_candidates"] = {{"keyframes", l.keyframes},   {"candidates", l.candidates}, {"verified", l.verified},
+  j["loop_candidates"] = {{"keyframes", l.keyframes},     {"candidates", l.candidates}, {"verified", l.verified},
                           {"implausible", l.implausible}, {"consistent", l.consistent}, {"confirming", l.confirming},
-                          {"closures", l.closures},     {"merges", l.merges},         {"time_ms", number(l.time_ms)}};
+                          {"closures", l.closures},       {"merges", l.merges},
+                          {"time_ms", json_number(l.time_ms)}};
   j["threaded_mapping"] = run.threaded;
   j["threads"] = run.threads;
   j["playback_rate"] = run.playback_rate;
-  j["wall_s"] = number(run.wall_s);
+  j["wall_s"] = json_number(run.wall_s);
   j["stage_ms"] = {{"io_wait", stage(t.io_wait)},
                    {"depth", stage(t.depth)},
                    {"extraction", stage(t.extraction)},

@@ -5,9 +5,13 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numbers>
 
 namespace rgbl::sim_detail {
+
+// No hit yet: where the ray casts of the scene and the renderer start their nearest-hit search.
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // splitmix64's finaliser: a bijective 64-bit mix.
 inline std::uint64_t mix64(std::uint64_t z) {

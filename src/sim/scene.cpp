@@ -14,7 +14,7 @@ namespace {
 
 using sim_detail::Rng;
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using sim_detail::kInf;
 
 // Footprint of an object in the ground plane: an oriented rectangle (cylinders: their square).
 struct Footprint {

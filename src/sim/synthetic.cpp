@@ -21,7 +21,7 @@ using sim_detail::Rgb;
 
 constexpr double kKittiWidth = 1226.0, kKittiHeight = 370.0;
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using sim_detail::kInf;
 
 // Runs fn(i) for i in [0, n), items interleaved over `threads` threads (rows of an image differ in
 // cost: sky is cheap, street is not). Results must not depend on which thread ran an item.
