@@ -14,7 +14,7 @@
 # --a-saved PREFIX: side A's results are not run but read from PREFIX-<nFeatures>.json, saved by an
 # earlier ab-table run (e.g. --a-saved /tmp/ab/cand/b: that run's B side), which halves the time of
 # judging candidates against one main. They must come from the same suite arguments and samples; runs
-# missing from either side are left out of the summary, which says how many.
+# missing from either side are left out of the summary, which names them.
 # Each build directory needs bin/rgbl and bin/rgbl_accuracy_table. With --no-variants one sample of
 # one build took 1.1-2.2 min here (2 cores, a CI run beside it): about 18 min for the defaults.
 set -euo pipefail

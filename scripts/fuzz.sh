@@ -5,14 +5,17 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
+# One libFuzzer process per core at a time (each is single-threaded); the results are reported in
+# the targets' order once all have run.
+parallel="${RGBL_FUZZ_JOBS:-$(nproc)}"
+case "$parallel" in
+  ''|*[!0-9]*|0) echo "fuzz: RGBL_FUZZ_JOBS takes a whole number >= 1, got '$parallel'" >&2; exit 2 ;;
+esac
 RGBL_FUZZ=1 ./scripts/install-deps.sh
 cmake --preset fuzz
 cmake --build --preset fuzz
 scratch="$(mktemp -d)"
 trap 'rm -rf "$scratch"' EXIT
-# One libFuzzer process per core at a time (each is single-threaded); the results are reported in
-# the targets' order once all have run.
-jobs="${RGBL_FUZZ_JOBS:-$(nproc)}"
 run_one() {
   local fuzzer="$1" name="$2"
   if "$fuzzer" "$scratch/$name" -max_total_time="$seconds" -rss_limit_mb=4096 -timeout=10 \
@@ -28,7 +31,7 @@ for fuzzer in build/fuzz/bin/fuzz_*; do
   names+=("$name")
   mkdir -p "$scratch/$name"
   cp -r "fuzz/corpus/$name/." "$scratch/$name/" 2>/dev/null || true
-  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n || true; done
+  while [ "$(jobs -rp | wc -l)" -ge "$parallel" ]; do wait -n || true; done
   echo "fuzz: $name for ${seconds}s"
   run_one "$fuzzer" "$name" &
 done

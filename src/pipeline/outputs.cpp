@@ -170,7 +170,7 @@ std::string summary_json(const RunResult& run) {
   j["rejected_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_rejected; });
   j["min_inliers_ok"] = min_inliers ? Json(*min_inliers) : Json(nullptr);
   const auto scan_age = run.scan_age_median();
-  j["scan_to_image_ms"] = scan_age ? Json(json_number(*scan_age * 1000.0)) : Json(nullptr);  // median; 0: simultaneous
+  j["scan_to_image_ms"] = scan_age ? json_number(*scan_age * 1000.0) : Json(nullptr);  // median; 0: simultaneous
   j["keyframes"] = run.keyframe_count();
   j["landmarks"] = run.landmarks.size();
   j["loop_closing"] = run.loop_closing;
