@@ -1,0 +1,100 @@
+#pragma once
+// Registration of one LiDAR scan onto another from a pose guess: point-to-plane ICP with a robust
+// (Cauchy) weight, and a check that the result is pinned down in every direction. Where the images
+// cannot tell where the camera is (after a gap in the frames, a new map was started from the motion
+// model's guess), two scans 30 m apart still share the road's shape, kerbs, poles and facades.
+//
+// ICP finds the nearest minimum, and on a road between two straight rows of trees or guard rails that
+// minimum slides along the road: every along-track shift fits the road and the rails equally. Such a
+// result is not a measurement. So the result is probed: moved by probe_shift_m along each axis, it
+// must lose at least min_probe_loss of the points that land on the reference. A true registration is
+// a peak (sequence 04, 32 m apart: 25 % lost at 1 m along the road); a slide is a ridge (the same road
+// 35 m off: nothing lost).
+
+#include "rgbl/geometry/point_cloud.hpp"
+#include "rgbl/geometry/scan_agreement.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <optional>
+
+namespace rgbl {
+
+struct ScanRegistrationOptions {
+  double min_range = 3.0;         // m: nearer returns are the car itself
+  double max_range = 60.0;        // m: two scans 30 m apart overlap out here
+  double reference_voxel = 0.5;   // m: the reference keeps one point (the mean) per voxel of this edge
+  double query_voxel = 1.0;       // m: the query, coarser (fewer, spread evenly over the scene)
+  double normal_radius = 1.0;     // m: a reference point's plane is fitted to its neighbours within this
+  int min_normal_points = 5;
+  // Correspondences within coarse_distance for the first coarse_iterations (the guess may be a metre
+  // or two off), then within fine_distance.
+  double coarse_distance = 1.5;   // m
+  int coarse_iterations = 5;
+  double fine_distance = 0.5;     // m
+  double robust_scale = 0.2;      // m: Cauchy weight 1 / (1 + (r / scale)^2) of a plane distance r
+  int max_iterations = 50;
+  double converged_m = 1e-3;      // an update below both ends the iterations
+  double converged_deg = 0.01;
+  std::size_t min_correspondences = 200;
+  // The probe: points of the query (reference_voxel) agreeing within agreement_tolerance of a
+  // reference point, at the result and moved by probe_shift_m along each axis of the reference.
+  double agreement_tolerance = 0.3;  // m
+  double probe_shift_m = 1.0;
+  // A search over the heading for a guess that may be turned too far for ICP to recover (a gap in a
+  // bend): ICP also starts from the guess turned about the query's vertical (z) axis by every multiple
+  // of yaw_step_deg within +-yaw_range_deg, and of the converged results the one where most points
+  // land wins. 0: the guess alone.
+  double yaw_range_deg = 0.0;
+  double yaw_step_deg = 5.0;
+  // The same along the guess's direction of travel (its translation), for a guess too long or short
+  // (a car braking in a gap): starts every along_step_m within +-along_range_m, each with every
+  // heading above. 0: the guess's position alone.
+  double along_range_m = 0.0;
+  double along_step_m = 2.0;
+  // The search runs ICP from every start on a coarser query (one point per search_voxel) for
+  // search_iterations, ranks the results by the share of those points that land, and refines the
+  // refine_best best that are distinct (more than probe_shift_m or half a yaw step apart) on the full
+  // query; of those that converge, the one where most points land wins.
+  double search_voxel = 2.0;  // m
+  int search_iterations = 10;
+  std::size_t refine_best = 3;
+
+  void validate() const;
+};
+
+// One point per voxel of edge `voxel` (the mean of the voxel's returns within the range), in the frame
+// T_frame_lidar maps into.
+ScanSample voxel_downsample(PointCloudView scan, const Eigen::Isometry3d& T_frame_lidar, double min_range,
+                            double max_range, double voxel);
+
+struct ScanRegistration {
+  Eigen::Isometry3d T_reference_query = Eigen::Isometry3d::Identity();
+  int iterations = 0;
+  bool converged = false;           // the last update was below converged_m and converged_deg
+  int starts = 1, converged_starts = 0;  // of the search; converged: of the refined ones
+  // The best agreement among the other refined results that converged elsewhere (more than
+  // probe_shift_m or half a yaw step from the winner): another optimum that fits about as well makes
+  // the winner a coin toss.
+  double runner_up_agreement = 0.0;
+  std::size_t correspondences = 0;  // of the last iteration
+  std::size_t query_points = 0;
+  // Of the query's points at reference_voxel: the share landing on the reference at the result, and
+  // the smallest share of those lost when the result is moved by probe_shift_m along an axis (0 when
+  // some probe lands as well or better).
+  double agreement = 0.0;
+  double min_probe_loss = 0.0;
+};
+
+// Registers `query` (a scan in its own LiDAR frame) onto `reference` (another, in its own) from the
+// guess T_reference_query (and the heading search's starts). Without a converged start, the guess's
+// own run is returned with converged false. nullopt when there is not enough to register (fewer than
+// min_correspondences correspondences, or a singular system, from every start). Throws ConfigError on
+// bad options.
+std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCloudView query,
+                                               const Eigen::Isometry3d& T_reference_query_guess,
+                                               const ScanRegistrationOptions& options = {});
+
+}  // namespace rgbl

@@ -1,0 +1,359 @@
+#include "rgbl/geometry/scan_registration.hpp"
+
+#include "rgbl/core/error.hpp"
+#include "rgbl/geometry/se3.hpp"
+#include "rgbl/geometry/voxel_index.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+namespace rgbl {
+
+void ScanRegistrationOptions::validate() const {
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  require(std::isfinite(min_range) && min_range >= 0.0, "scan_registration.min_range", ">= 0 m");
+  require(std::isfinite(max_range) && max_range > min_range, "scan_registration.max_range", "finite and > min_range");
+  require(positive(reference_voxel), "scan_registration.reference_voxel", "> 0 m");
+  require(positive(query_voxel), "scan_registration.query_voxel", "> 0 m");
+  require(positive(normal_radius), "scan_registration.normal_radius", "> 0 m");
+  require(min_normal_points >= 3, "scan_registration.min_normal_points", ">= 3 points (a plane)");
+  require(positive(coarse_distance), "scan_registration.coarse_distance", "> 0 m");
+  require(coarse_iterations >= 0, "scan_registration.coarse_iterations", ">= 0");
+  require(positive(fine_distance) && fine_distance <= coarse_distance, "scan_registration.fine_distance",
+          "> 0 m and <= coarse_distance");
+  require(positive(robust_scale), "scan_registration.robust_scale", "> 0 m");
+  require(max_iterations >= 1, "scan_registration.max_iterations", ">= 1");
+  require(positive(converged_m), "scan_registration.converged_m", "> 0 m");
+  require(positive(converged_deg), "scan_registration.converged_deg", "> 0 deg");
+  require(min_correspondences >= 6, "scan_registration.min_correspondences", ">= 6 (six unknowns)");
+  require(positive(agreement_tolerance), "scan_registration.agreement_tolerance", "> 0 m");
+  require(positive(probe_shift_m), "scan_registration.probe_shift_m", "> 0 m");
+  require(std::isfinite(yaw_range_deg) && yaw_range_deg >= 0.0 && yaw_range_deg <= 180.0,
+          "scan_registration.yaw_range_deg", "in [0, 180] deg");
+  require(positive(yaw_step_deg), "scan_registration.yaw_step_deg", "> 0 deg");
+  require(std::isfinite(along_range_m) && along_range_m >= 0.0 && along_range_m <= 100.0,
+          "scan_registration.along_range_m", "in [0, 100] m");
+  require(positive(along_step_m), "scan_registration.along_step_m", "> 0 m");
+  require(positive(search_voxel), "scan_registration.search_voxel", "> 0 m");
+  require(search_iterations >= 1, "scan_registration.search_iterations", ">= 1");
+  require(refine_best >= 1, "scan_registration.refine_best", ">= 1");
+}
+
+ScanSample voxel_downsample(PointCloudView scan, const Eigen::Isometry3d& T_frame_lidar, double min_range,
+                            double max_range, double voxel) {
+  require(std::isfinite(voxel) && voxel > 0.0, "voxel_downsample: voxel", "> 0 m");
+  const auto min2 = static_cast<float>(min_range * min_range);
+  const auto max2 = static_cast<float>(max_range * max_range);
+  const auto inv = static_cast<float>(1.0 / voxel);
+  VoxelIndex index;
+  std::vector<Eigen::Vector3f> sums;
+  std::vector<float> counts;
+  for (const LidarPoint& l : scan) {
+    const Eigen::Vector3f p(l.x, l.y, l.z);
+    const float r2 = p.squaredNorm();
+    if (!(r2 >= min2 && r2 <= max2)) continue;  // also drops NaN
+    const auto [slot, added] = index.emplace(voxel_of(p, inv), static_cast<std::uint32_t>(sums.size()));
+    if (added) {
+      sums.emplace_back(Eigen::Vector3f::Zero());
+      counts.push_back(0.0F);
+    }
+    sums[slot] += p;
+    counts[slot] += 1.0F;
+  }
+  const Eigen::Isometry3f T = T_frame_lidar.cast<float>();
+  ScanSample sample;
+  sample.points.reserve(sums.size());
+  for (std::size_t i = 0; i < sums.size(); ++i) sample.points.push_back(T * (sums[i] / counts[i]));
+  return sample;
+}
+
+namespace {
+
+// Reference points with their planes, grouped by voxels of edge `edge` for neighbour searches within
+// that distance (the 3x3x3 block around a point holds them all).
+class PlaneGrid {
+ public:
+  PlaneGrid(const ScanSample& points, const ScanRegistrationOptions& options)
+      : edge_(static_cast<float>(std::max(options.coarse_distance, options.normal_radius))), inv_(1.0F / edge_) {
+    group(points.points);
+    fit_planes(options);
+  }
+
+  // The nearest reference point with a plane within max_distance of p: its index, or -1.
+  int nearest(const Eigen::Vector3f& p, float max_distance) const {
+    int best = -1;
+    float best2 = max_distance * max_distance;
+    for_neighbours(p, [&](std::uint32_t j) {
+      if (!has_plane_[j]) return;
+      const float d2 = (points_[j] - p).squaredNorm();
+      if (d2 < best2) {
+        best2 = d2;
+        best = static_cast<int>(j);
+      }
+    });
+    return best;
+  }
+
+  const Eigen::Vector3f& point(int j) const { return points_[static_cast<std::size_t>(j)]; }
+  const Eigen::Vector3f& normal(int j) const { return normals_[static_cast<std::size_t>(j)]; }
+
+ private:
+  template <typename Visit>
+  void for_neighbours(const Eigen::Vector3f& p, Visit&& visit) const {
+    constexpr float kFar = 1e5F;  // a pose gone wild: nothing near, and voxel keys stay in range
+    if (!(p.cwiseAbs().maxCoeff() < kFar)) return;
+    const VoxelKey c = voxel_of(p, inv_);
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          const std::uint32_t slot = index_.find({c.x + dx, c.y + dy, c.z + dz});
+          if (slot == VoxelIndex::npos) continue;
+          for (std::uint32_t j = begin_[slot]; j < begin_[slot + 1]; ++j) visit(j);
+        }
+      }
+    }
+  }
+
+  void group(const std::vector<Eigen::Vector3f>& points) {
+    std::vector<std::uint32_t> slot_of(points.size());
+    std::vector<std::uint32_t> counts;
+    index_.reserve(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const auto [slot, added] = index_.emplace(voxel_of(points[i], inv_), static_cast<std::uint32_t>(counts.size()));
+      if (added) counts.push_back(0);
+      ++counts[slot];
+      slot_of[i] = slot;
+    }
+    begin_.assign(counts.size() + 1, 0);
+    for (std::size_t s = 0; s < counts.size(); ++s) begin_[s + 1] = begin_[s] + counts[s];
+    std::vector<std::uint32_t> next(begin_.begin(), begin_.end() - 1);
+    points_.resize(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) points_[next[slot_of[i]]++] = points[i];
+  }
+
+  void fit_planes(const ScanRegistrationOptions& options) {
+    const auto radius2 = static_cast<float>(options.normal_radius * options.normal_radius);
+    normals_.assign(points_.size(), Eigen::Vector3f::Zero());
+    has_plane_.assign(points_.size(), false);
+    for (std::size_t i = 0; i < points_.size(); ++i) {
+      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      Eigen::Matrix3f outer = Eigen::Matrix3f::Zero();
+      int n = 0;
+      for_neighbours(points_[i], [&](std::uint32_t j) {
+        const Eigen::Vector3f d = points_[j] - points_[i];  // about the point: better conditioned
+        if (d.squaredNorm() > radius2) return;
+        sum += d;
+        outer += d * d.transpose();
+        ++n;
+      });
+      if (n < options.min_normal_points) continue;
+      const Eigen::Vector3f mean = sum / static_cast<float>(n);
+      const Eigen::Matrix3f covariance = outer / static_cast<float>(n) - mean * mean.transpose();
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver(covariance);
+      if (solver.info() != Eigen::Success) continue;
+      normals_[i] = solver.eigenvectors().col(0);  // smallest eigenvalue first
+      has_plane_[i] = normals_[i].allFinite();
+    }
+  }
+
+  float edge_, inv_;
+  VoxelIndex index_;
+  std::vector<std::uint32_t> begin_;
+  std::vector<Eigen::Vector3f> points_, normals_;
+  std::vector<bool> has_plane_;
+};
+
+}  // namespace
+
+namespace {
+
+// One ICP run from `guess`: the pose, whether it converged, the last iteration's correspondences and
+// the iterations taken; nullopt when too few correspondences or a singular system.
+struct IcpRun {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  bool converged = false;
+  std::size_t correspondences = 0;
+  int iterations = 0;
+};
+
+std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, const Eigen::Isometry3d& guess,
+                              const ScanRegistrationOptions& options) {
+  using Matrix6d = Eigen::Matrix<double, 6, 6>;
+  const double converged_rad = options.converged_deg * std::numbers::pi / 180.0;
+  const double scale2 = options.robust_scale * options.robust_scale;
+  IcpRun run;
+  run.T = guess;
+  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    const auto max_distance =
+        static_cast<float>(iteration < options.coarse_iterations ? options.coarse_distance : options.fine_distance);
+    const Eigen::Isometry3f Tf = run.T.cast<float>();
+    Matrix6d H = Matrix6d::Zero();
+    Vector6d g = Vector6d::Zero();
+    std::size_t used = 0;
+    for (const Eigen::Vector3f& q : query.points) {
+      const Eigen::Vector3f x = Tf * q;
+      const int j = grid.nearest(x, max_distance);
+      if (j < 0) continue;
+      const Eigen::Vector3d n = grid.normal(j).cast<double>();
+      const Eigen::Vector3d xd = x.cast<double>();
+      const double r = n.dot(xd - grid.point(j).cast<double>());
+      // d(n . (exp(xi) x)) / d[rho; phi] at 0 = [n; x x n]
+      Vector6d J;
+      J << n, xd.cross(n);
+      const double w = 1.0 / (1.0 + r * r / scale2);
+      H.noalias() += w * J * J.transpose();
+      g.noalias() += w * r * J;
+      ++used;
+    }
+    run.correspondences = used;
+    run.iterations = iteration + 1;
+    if (used < options.min_correspondences) return std::nullopt;
+    const Eigen::LDLT<Matrix6d> solver(H);
+    if (solver.info() != Eigen::Success) return std::nullopt;
+    const Vector6d xi = -solver.solve(g);
+    if (!xi.allFinite()) return std::nullopt;
+    run.T = se3_exp(xi) * run.T;
+    if (xi.head<3>().norm() < options.converged_m && xi.tail<3>().norm() < converged_rad) {
+      run.converged = true;
+      break;
+    }
+  }
+  return run;
+}
+
+}  // namespace
+
+std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCloudView query,
+                                               const Eigen::Isometry3d& T_reference_query_guess,
+                                               const ScanRegistrationOptions& options) {
+  options.validate();
+  const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
+  const ScanSample reference_points =
+      voxel_downsample(reference, identity, options.min_range, options.max_range, options.reference_voxel);
+  const ScanSample query_points =
+      voxel_downsample(query, identity, options.min_range, options.max_range, options.query_voxel);
+  const PlaneGrid grid(reference_points, options);
+  // the agreement is counted on the query at the reference's density
+  const ScanSample dense =
+      voxel_downsample(query, identity, options.min_range, options.max_range, options.reference_voxel);
+  const ScanAgreement agreement(reference_points, options.agreement_tolerance);
+  const auto share = [&](const Eigen::Isometry3d& T) {
+    return dense.empty() ? 0.0 : static_cast<double>(agreement.count(dense, T)) / static_cast<double>(dense.points.size());
+  };
+
+  // The starts: the guess moved along its own direction of travel by every multiple of along_step_m
+  // within along_range_m (a car braking or speeding up in a gap), each turned about the query's
+  // vertical axis by every multiple of yaw_step_deg within yaw_range_deg (a bend); nearest first.
+  const auto offsets = [](double range, double step) {
+    std::vector<double> out{0.0};
+    for (double v = step; v <= range + 1e-9; v += step) {
+      out.push_back(v);
+      out.push_back(-v);
+    }
+    return out;
+  };
+  const std::vector<double> yaws = offsets(options.yaw_range_deg, options.yaw_step_deg);
+  const std::vector<double> alongs = offsets(options.along_range_m, options.along_step_m);
+  const Eigen::Vector3d travel = T_reference_query_guess.translation().norm() > 1e-6
+                                     ? Eigen::Vector3d(T_reference_query_guess.translation().normalized())
+                                     : Eigen::Vector3d::UnitX();
+  const double apart_rad = 0.5 * options.yaw_step_deg * std::numbers::pi / 180.0;
+  const auto distinct = [&](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+    const Eigen::Isometry3d d = a.inverse() * b;
+    return d.translation().norm() > options.probe_shift_m || rotation_angle(d.linear()) > apart_rad;
+  };
+
+  // With more than one start, a search first: ICP on a coarser query (search_voxel) for a few
+  // iterations from each start, ranked by the share of those points that land; the refine_best
+  // distinct best are refined below. Without a search, the guess is refined alone.
+  std::vector<Eigen::Isometry3d> seeds;
+  const std::size_t start_count = yaws.size() * alongs.size();
+  if (start_count == 1) {
+    seeds.push_back(T_reference_query_guess);
+  } else {
+    const ScanSample coarse =
+        voxel_downsample(query, identity, options.min_range, options.max_range, options.search_voxel);
+    ScanRegistrationOptions search = options;
+    search.max_iterations = options.search_iterations;
+    search.min_correspondences = std::max<std::size_t>(
+        6, options.min_correspondences * coarse.points.size() / std::max<std::size_t>(1, query_points.points.size()));
+    std::vector<std::pair<double, Eigen::Isometry3d>> found;  // share of the coarse points landing, pose
+    for (const double along : alongs) {
+      for (const double yaw : yaws) {
+        Eigen::Isometry3d start =
+            T_reference_query_guess *
+            Eigen::Isometry3d(Eigen::AngleAxisd(yaw * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()));
+        start.translation() += along * travel;
+        const auto run = run_icp(grid, coarse, start, search);
+        if (!run) continue;
+        found.emplace_back(static_cast<double>(agreement.count(coarse, run->T)) / static_cast<double>(coarse.points.size()),
+                           run->T);
+      }
+    }
+    std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (const auto& [score, T] : found) {
+      if (seeds.size() >= options.refine_best) break;
+      if (std::all_of(seeds.begin(), seeds.end(), [&](const Eigen::Isometry3d& o) { return distinct(o, T); })) {
+        seeds.push_back(T);
+      }
+    }
+  }
+
+  struct Candidate {
+    IcpRun run;
+    double agreement = 0.0;
+  };
+  std::vector<Candidate> converged;
+  std::optional<IcpRun> first;  // the first seed's run, reported when nothing converges
+  for (const Eigen::Isometry3d& seed : seeds) {
+    const auto run = run_icp(grid, query_points, seed, options);
+    if (run && !first) first = run;
+    if (run && run->converged) converged.push_back({*run, share(run->T)});
+  }
+  if (converged.empty() && !first) return std::nullopt;
+
+  ScanRegistration result;
+  result.query_points = query_points.points.size();
+  result.starts = static_cast<int>(start_count);
+  result.converged_starts = static_cast<int>(converged.size());
+  if (converged.empty()) {
+    result.T_reference_query = first->T;
+    result.iterations = first->iterations;
+    result.correspondences = first->correspondences;
+    result.agreement = share(first->T);
+    return result;  // not converged: no probe
+  }
+  const auto best = std::max_element(converged.begin(), converged.end(),
+                                     [](const Candidate& a, const Candidate& b) { return a.agreement < b.agreement; });
+  result.T_reference_query = best->run.T;
+  result.converged = true;
+  result.iterations = best->run.iterations;
+  result.correspondences = best->run.correspondences;
+  result.agreement = best->agreement;
+  // the best of the converged results elsewhere (another optimum, not the same one reached twice)
+  for (const Candidate& c : converged) {
+    if (distinct(best->run.T, c.run.T)) result.runner_up_agreement = std::max(result.runner_up_agreement, c.agreement);
+  }
+
+  // The probe: moved along each axis of the reference, the result must lose landing points.
+  const std::size_t at_result = agreement.count(dense, result.T_reference_query);
+  result.min_probe_loss = at_result == 0 ? 0.0 : 1.0;
+  for (int axis = 0; axis < 3 && at_result > 0; ++axis) {
+    for (const double sign : {-1.0, 1.0}) {
+      Eigen::Isometry3d moved = result.T_reference_query;
+      moved.translation()[axis] += sign * options.probe_shift_m;
+      const std::size_t there = agreement.count(dense, moved);
+      const double loss = 1.0 - static_cast<double>(there) / static_cast<double>(at_result);
+      result.min_probe_loss = std::min(result.min_probe_loss, std::max(loss, 0.0));
+    }
+  }
+  return result;
+}
+
+}  // namespace rgbl
