@@ -311,6 +311,7 @@ class LoopClosure:
     frame_index: int
     matched_frame_index: int
     merged: bool
+    bridged: bool
     place_source: str
     place_similarity: float
     inliers: int

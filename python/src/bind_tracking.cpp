@@ -81,6 +81,7 @@ void bind_tracking(py::module_& m) {
       .def_readonly("frame_index", &LoopClosure::frame_index, "Of the keyframe that closed it.")
       .def_readonly("matched_frame_index", &LoopClosure::matched_frame_index, "Of the older keyframe it matched.")
       .def_readonly("merged", &LoopClosure::merged)
+      .def_readonly("bridged", &LoopClosure::bridged, "The merge registered the LiDAR scans across a gap.")
       .def_readonly("place_source", &LoopClosure::place_source)
       .def_readonly("place_similarity", &LoopClosure::place_similarity)
       .def_readonly("inliers", &LoopClosure::inliers)

@@ -123,6 +123,8 @@ void LoopClosingSettings::validate() const {
   require(!max_drift_percent || *max_drift_percent > 0.0, "LoopClosing.MaxDriftPercent", "a percentage > 0");
   require(!max_drift_deg_per_100m || *max_drift_deg_per_100m > 0.0, "LoopClosing.MaxDriftDegPer100m",
           "degrees per 100 m > 0");
+  require(!bridge_max_gap_s || (std::isfinite(*bridge_max_gap_s) && *bridge_max_gap_s > 0.0), "LoopClosing.BridgeMaxGap",
+          "seconds > 0");
 }
 
 Settings read_settings(const std::filesystem::path& yaml) {
@@ -383,6 +385,8 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.loop_closing.fuse = flag("LoopClosing.Fuse");
   s.loop_closing.global_ba = flag("LoopClosing.GlobalBA");
   s.loop_closing.merge_maps = flag("LoopClosing.MergeMaps");
+  s.loop_closing.bridge = flag("LoopClosing.BridgeGaps");
+  s.loop_closing.bridge_max_gap_s = r.number({"LoopClosing.BridgeMaxGap"});
   s.place_culling = flag("LocalMapping.PlaceCulling");
   s.reference_landmark_ratio = r.number({"Tracking.ReferenceLandmarkRatio"});
   if (s.reference_landmark_ratio && !(*s.reference_landmark_ratio >= 0.0 && *s.reference_landmark_ratio <= 1.0))

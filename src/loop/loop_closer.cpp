@@ -15,10 +15,29 @@
 #include <numbers>
 #include <shared_mutex>
 #include <span>
+#include <string_view>
 #include <unordered_map>
 #include <utility>
 
 namespace rgbl {
+
+void MapBridgeOptions::validate() const {
+  const auto non_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  require(std::isfinite(max_gap_s) && max_gap_s > 0.0, "loop_closing.bridge.max_gap_s", "> 0 s");
+  require(non_negative(allowance_m), "loop_closing.bridge.allowance_m", ">= 0 m");
+  require(non_negative(max_acceleration), "loop_closing.bridge.max_acceleration", ">= 0 m/s^2");
+  require(non_negative(allowance_deg), "loop_closing.bridge.allowance_deg", ">= 0 deg");
+  require(non_negative(max_turn_rate_deg_s), "loop_closing.bridge.max_turn_rate_deg_s", ">= 0 deg/s");
+  require(std::isfinite(min_probe_loss) && min_probe_loss >= 0.0 && min_probe_loss <= 1.0,
+          "loop_closing.bridge.min_probe_loss", "in [0, 1]");
+  require(std::isfinite(max_yaw_search_deg) && max_yaw_search_deg >= 0.0 && max_yaw_search_deg <= 180.0,
+          "loop_closing.bridge.max_yaw_search_deg", "in [0, 180] deg");
+  require(std::isfinite(max_along_search_m) && max_along_search_m >= 0.0 && max_along_search_m <= 100.0,
+          "loop_closing.bridge.max_along_search_m", "in [0, 100] m");
+  require(std::isfinite(max_runner_up_ratio) && max_runner_up_ratio > 0.0 && max_runner_up_ratio <= 1.0,
+          "loop_closing.bridge.max_runner_up_ratio", "in (0, 1]");
+  registration.validate();
+}
 
 void LoopClosingOptions::validate() const {
   places.validate();
@@ -30,6 +49,7 @@ void LoopClosingOptions::validate() const {
   require(consistency_tolerance_deg > 0.0, "loop_closing.consistency_tolerance_deg", "> 0 deg");
   require(min_correction_m >= 0.0, "loop_closing.min_correction_m", ">= 0 m");
   require(min_correction_deg >= 0.0, "loop_closing.min_correction_deg", ">= 0 deg");
+  bridge.validate();
   require(max_drift_percent > 0.0, "loop_closing.max_drift_percent", "> 0 % of the distance driven");
   require(max_drift_deg_per_100m > 0.0, "loop_closing.max_drift_deg_per_100m", "> 0 deg per 100 m");
   require(drift_allowance_m >= 0.0, "loop_closing.drift_allowance_m", ">= 0 m");
@@ -163,6 +183,54 @@ int fuse_across(Map& map, const PinholeCamera& camera, const LoopClosingOptions&
   return fused;
 }
 
+constexpr std::string_view kBridgeSource = "lidar_bridge";
+
+// The first keyframe of a map started after a loss, placed on the old map's last keyframe by
+// registering its scan onto that keyframe's scan from where the new map was anchored (the motion
+// model's guess over the gap). nullopt unless the registration converged, is a clear optimum and moves
+// the new map no more than the guess can be off.
+std::optional<DetectedLoop> bridge_maps(const MapBridgeOptions& o, const Eigen::Isometry3d& T_cam_lidar,
+                                        const Keyframe& last, PointCloudView last_scan, const Keyframe& current,
+                                        PointCloudView scan) {
+  const double gap = current.timestamp - last.timestamp;
+  if (!(gap > 0.0 && gap <= o.max_gap_s)) {
+    logger()->debug("bridge: keyframes {} and {} are {:.2f} s apart (at most {:.2f} s): not registered",
+                    last.id.value, current.id.value, gap, o.max_gap_s);
+    return std::nullopt;
+  }
+  const double allowed_m = o.allowance_m + 0.5 * o.max_acceleration * gap * gap;
+  const double allowed_deg = o.allowance_deg + o.max_turn_rate_deg_s * gap;
+  const Eigen::Isometry3d T_lidar_cam = T_cam_lidar.inverse();
+  const Eigen::Isometry3d T_last_current_guess = last.T_cam_world * current.T_cam_world.inverse();
+  ScanRegistrationOptions registration = o.registration;
+  registration.yaw_range_deg = std::min(allowed_deg, o.max_yaw_search_deg);
+  registration.along_range_m = std::min(allowed_m, o.max_along_search_m);
+  const auto r = register_scans(last_scan, scan, T_lidar_cam * T_last_current_guess * T_cam_lidar, registration);
+  if (!r) {
+    logger()->info("bridge: frame {} onto frame {}: too little to register", current.frame_index, last.frame_index);
+    return std::nullopt;
+  }
+  const Eigen::Isometry3d T_last_current = T_cam_lidar * r->T_reference_query * T_lidar_cam;
+  const Eigen::Isometry3d T_current_world = T_last_current.inverse() * last.T_cam_world;
+  const PoseChange asked = pose_change(current.T_cam_world, T_current_world);
+  const bool accepted = r->converged && r->min_probe_loss >= o.min_probe_loss && asked.m <= allowed_m &&
+                        asked.deg <= allowed_deg && r->runner_up_agreement <= o.max_runner_up_ratio * r->agreement;
+  logger()->info("bridge: frame {} onto frame {} ({:.2f} s, {:.1f} m apart): {} of {} starts converged, {} "
+                 "iterations, {} correspondences, agreement {:.3f} (runner-up {:.3f}), probe loss {:.3f} (>= {:.2f}), "
+                 "moves the new map {:.2f} m, {:.2f} deg (at most {:.2f} m, {:.2f} deg): {}",
+                 current.frame_index, last.frame_index, gap, T_last_current.translation().norm(), r->converged_starts,
+                 r->starts, r->iterations, r->correspondences, r->agreement, r->runner_up_agreement, r->min_probe_loss,
+                 o.min_probe_loss, asked.m, asked.deg, allowed_m, allowed_deg, accepted ? "accepted" : "refused");
+  if (!accepted) return std::nullopt;
+  DetectedLoop loop;
+  loop.keyframe = current.id;
+  loop.verification.T_cam_world = T_current_world;
+  loop.verification.constraint = {current.id, last.id, T_last_current.inverse()};
+  loop.verification.counts.inliers = static_cast<int>(r->correspondences);
+  loop.place = {static_cast<std::size_t>(last.id.value), r->agreement, kBridgeSource};
+  return loop;
+}
+
 // Moves every keyframe and landmark of the map rooted at `root` by T_old_new (a point x of that map is
 // at T_old_new * x in the matched map) and hangs its root from `matched`.
 void merge_maps(Map& map, KeyframeId root, KeyframeId matched, const Eigen::Isometry3d& T_old_new) {
@@ -185,6 +253,11 @@ void merge_maps(Map& map, KeyframeId root, KeyframeId matched, const Eigen::Isom
 }
 
 }  // namespace
+
+LoopCloser::LoopCloser(const CameraCalibration& calibration, LoopClosingOptions options)
+    : LoopCloser(calibration.camera, std::move(options)) {
+  T_cam_lidar_ = calibration.T_cam_lidar;
+}
 
 LoopCloser::LoopCloser(const PinholeCamera& camera, LoopClosingOptions options)
     : camera_(camera), options_(std::move(options)) {
@@ -297,6 +370,16 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
       return candidate.value <= keyframe.value - options_.min_keyframe_gap && map.keyframe(candidate) != nullptr &&
              !current->covisibility.contains(candidate) && (options_.merge_maps || roots(candidate) == root);
     };
+    // A new map's first keyframe: bridged to the map before it if the scans register.
+    const Keyframe* last = last_keyframe_.valid() ? map.keyframe(last_keyframe_) : nullptr;
+    if (options_.merge_maps && options_.bridge.enabled && T_cam_lidar_ && last != nullptr && !current->parent.valid() &&
+        roots(last_keyframe_) != root && !scan.empty() && !last_scan_.empty()) {
+      ++stats_.bridge_attempts;
+      if (auto bridged = bridge_maps(options_.bridge, *T_cam_lidar_, *last, last_scan_, *current, scan)) {
+        best = std::move(bridged);
+        step.consistent = true;
+      }
+    }
     std::vector<std::size_t> neighbours;
     for (const KeyframeId k : map.best_covisible(keyframe, options_.place_neighbours)) {
       neighbours.push_back(static_cast<std::size_t>(k.value));
@@ -317,6 +400,7 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
         }
       }
     }
+    if (step.consistent) candidates.clear();  // bridged: a merge already
     for (const PlaceCandidate& place : candidates) {
       const KeyframeId candidate{static_cast<int>(place.id)};
       ++step.candidates;
@@ -343,7 +427,7 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
         best = DetectedLoop{keyframe, std::move(*verified), place, {}};
       }
     }
-    if (best) {
+    if (best && !step.consistent) {
       std::vector<KeyframeId> previous;  // the newest live ones, newest first
       for (auto it = recent_.rbegin();
            it != recent_.rend() && std::cmp_less(previous.size() + 1, options_.consistent_keyframes); ++it) {
@@ -357,6 +441,10 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
     for (const auto& recognizer : places_) recognizer->add(query);  // under the lock: reads the descriptors
   }
   remember(keyframe);
+  if (options_.merge_maps && options_.bridge.enabled && T_cam_lidar_) {
+    last_keyframe_ = keyframe;
+    last_scan_.assign(scan.begin(), scan.end());
+  }
   stats_.candidates += step.candidates;
   stats_.verified += step.verified;
   stats_.implausible += step.implausible;
@@ -377,7 +465,7 @@ void LoopCloser::correct(Map& map, const DetectedLoop& loop, LoopCloserStep& ste
   logger()->info("{}: frame {} with frame {} ({} {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
                  "loop error {:.2f} -> {:.3f} m, keyframes moved up to {:.2f} m, {} landmarks fused, global BA {} "
                  "keyframes {:.0f} ms, {:.0f} ms",
-                 c.merged ? "maps merged" : "loop closed", c.frame_index, c.matched_frame_index, c.place_source,
+                 c.bridged ? "maps bridged" : c.merged ? "maps merged" : "loop closed", c.frame_index, c.matched_frame_index, c.place_source,
                  c.place_similarity, c.inliers, c.correction_m, c.correction_deg, c.correction.loop_error_before_m,
                  c.correction.loop_error_after_m, c.correction.max_keyframe_shift_m, c.fused_landmarks,
                  c.global_ba_keyframes, c.global_ba_ms, c.time_ms);
@@ -423,7 +511,9 @@ void LoopCloser::apply(Map& map, const DetectedLoop& loop, LoopCloserStep& step)
     const Eigen::Isometry3d T_old_new = loop.verification.T_cam_world.inverse() * T_cam_world_before;
     merge_maps(map, root, matched, T_old_new);
     closure.merged = true;
+    closure.bridged = loop.place.source == kBridgeSource;
     ++stats_.merges;
+    stats_.bridges += closure.bridged ? 1 : 0;
   }
   closure.correction = correct_loops(map, loops_, options_.correction);
   if (options_.fuse) closure.fused_landmarks = fuse_across(map, camera_, options_, keyframe, matched);

@@ -33,6 +33,7 @@ Json closure_json(const LoopClosure& c) {
   return {{"frame", c.frame_index},
           {"matched_frame", c.matched_frame_index},
           {"merge", c.merged},
+          {"bridge", c.bridged},
           {"place", c.place_source},
           {"place_similarity", json_number(c.place_similarity)},
           {"inliers", c.inliers},
@@ -178,6 +179,7 @@ std::string summary_json(const RunResult& run) {
   j["loop_candidates"] = {{"keyframes", l.keyframes},     {"candidates", l.candidates}, {"verified", l.verified},
                           {"implausible", l.implausible}, {"consistent", l.consistent}, {"confirming", l.confirming},
                           {"closures", l.closures},       {"merges", l.merges},
+                          {"bridge_attempts", l.bridge_attempts}, {"bridges", l.bridges},
                           {"time_ms", json_number(l.time_ms)}};
   j["threaded_mapping"] = run.threaded;
   j["threads"] = run.threads;
@@ -224,7 +226,7 @@ std::string summary_text(const RunResult& run) {
   for (const LoopClosure& c : run.loop_closures) {
     fmt::format_to(out, "  {} at frame {} with frame {}: map moved {:.2f} m / {:.2f} deg there, {} landmarks fused, "
                    "{:.0f} ms (global BA of {} keyframes {:.0f} ms)\n",
-                   c.merged ? "maps merged" : "loop closed", c.frame_index, c.matched_frame_index, c.correction_m,
+                   c.bridged ? "maps bridged" : c.merged ? "maps merged" : "loop closed", c.frame_index, c.matched_frame_index, c.correction_m,
                    c.correction_deg, c.fused_landmarks, c.time_ms, c.global_ba_keyframes, c.global_ba_ms);
   }
   if (const auto age = run.scan_age_median(); age && *age != 0.0) {

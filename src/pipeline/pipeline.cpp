@@ -81,6 +81,8 @@ void apply_settings(const Settings& s, Resolved p) {
   if (l.fuse) loop.fuse = *l.fuse;
   if (l.global_ba) loop.global_ba = *l.global_ba;
   if (l.merge_maps) loop.merge_maps = *l.merge_maps;
+  if (l.bridge) loop.bridge.enabled = *l.bridge;
+  if (l.bridge_max_gap_s) loop.bridge.max_gap_s = *l.bridge_max_gap_s;
   if (s.place_culling) p.system.mapping.place_culling = *s.place_culling;
   if (s.reference_landmark_ratio) p.system.tracker.reference_landmark_ratio = *s.reference_landmark_ratio;
   if (s.bounded_depth_error) p.system.tracker.pose.bounded_depth_error = *s.bounded_depth_error;

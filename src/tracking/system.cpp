@@ -158,7 +158,7 @@ struct System::Impl {
 
   Impl(SystemOptions o, CameraCalibration c, std::unique_ptr<DepthSource> d, FeatureExtractor e)
       : options(o), calibration(c), map(o.map), tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping),
-        closer(c.camera, o.loop_closing) {
+        closer(c, o.loop_closing) {
     if (d) builder.emplace(c, o.depth_noise, std::move(d), std::move(e), nullptr, o.tracker.scan_sample);
     if (threaded_loop_closing()) loop_thread = std::thread([this] { run_loop_closing(); });
     if (options.threaded_mapping) mapping_thread = std::thread([this] { run_mapping(); });

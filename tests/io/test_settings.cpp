@@ -142,7 +142,8 @@ TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
       tmp.write("loop.yaml", "%YAML:1.0\nLoopClosing.Enabled: 0\nLoopClosing.MaxPlaceDistance: 0.3\n"
                              "LoopClosing.ConsistentKeyframes: 4\nLoopClosing.MaxDriftPercent: 5\n"
                              "LoopClosing.MaxDriftDegPer100m: 4.5\nLoopClosing.Fuse: 1\nLoopClosing.GlobalBA: 1\n"
-                             "LoopClosing.MergeMaps: 0\nLoopClosing.Places: \"scan_context, bow\"\n"
+                             "LoopClosing.MergeMaps: 0\nLoopClosing.BridgeGaps: 0\nLoopClosing.BridgeMaxGap: 2.5\n"
+                             "LoopClosing.Places: \"scan_context, bow\"\n"
                              "LoopClosing.Vocabulary: \"voc/mine.rgblvoc\"\n"));
   CHECK(s.loop_closing.enabled == false);
   CHECK(s.loop_closing.places == std::vector<std::string>{"scan_context", "bow"});
@@ -154,6 +155,8 @@ TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
   CHECK(s.loop_closing.fuse == true);
   CHECK(s.loop_closing.global_ba == true);  // off by default
   CHECK(s.loop_closing.merge_maps == false);
+  CHECK(s.loop_closing.bridge == false);
+  CHECK(s.loop_closing.bridge_max_gap_s == 2.5);
   CHECK(s.warnings.empty());
   CHECK_THAT(error_of(tmp.write("l1.yaml", "%YAML:1.0\nLoopClosing.Enabled: 2\n")),
              Contains("'LoopClosing.Enabled': expected 0 (off) or 1 (on)"));
@@ -169,6 +172,8 @@ TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
              Contains("'LoopClosing.MaxDriftPercent': expected a percentage > 0"));
   CHECK_THAT(error_of(tmp.write("l5.yaml", "%YAML:1.0\nLoopClosing.GlobalBA: yes\n")),
              Contains("LoopClosing.GlobalBA"));
+  CHECK_THAT(error_of(tmp.write("l6.yaml", "%YAML:1.0\nLoopClosing.BridgeMaxGap: 0\n")),
+             Contains("'LoopClosing.BridgeMaxGap': expected seconds > 0"));
 }
 
 TEST_CASE("settings: rgbl's LiDAR occlusion keys", "[io][settings]") {

@@ -34,7 +34,8 @@ struct Outcome {
   std::vector<Eigen::Isometry3d> truth;  // T_world_cam0 of the frames fed
 };
 
-inline Outcome run(const std::filesystem::path& sequence, const std::vector<Step>& steps, bool threaded = false) {
+inline Outcome run(const std::filesystem::path& sequence, const std::vector<Step>& steps, bool threaded = false,
+                   const rgbl::LoopClosingOptions& loop_closing = {}) {
   const auto name = [](std::size_t i) { return fmt::format("{:06}", i); };
   const cv::Mat first = rgbl::read_image_file(sequence / "image_0" / (name(0) + ".png"), rgbl::ImageMode::grey);
   const auto kitti = rgbl::read_kitti_odometry_calibration(sequence / "calib.txt", first.cols, first.rows);
@@ -43,6 +44,7 @@ inline Outcome run(const std::filesystem::path& sequence, const std::vector<Step
   auto orb = std::make_shared<rgbl::OrbExtractor>();
   rgbl::SystemOptions options;
   options.threaded_mapping = threaded;
+  options.loop_closing = loop_closing;
   rgbl::System system(options, depth.calibration, rgbl::make_lidar_source({}, depth),
                       [orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
                         orb->extract(g, k, d);

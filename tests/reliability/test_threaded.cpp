@@ -64,6 +64,10 @@ TEST_CASE("threaded mapping: a jump of 20 frames starts a new map while mapping 
   for (const auto& r : o.results) new_maps += r.new_map ? 1 : 0;
   CHECK(new_maps == 1);
   CHECK(rgbl::has_pose(o.results.back().state));  // ok, or weak while mapping lags
+  // the loop thread may bridge the gap (reported with a later frame, if before the last): only that
+  for (const auto& r : o.results) {
+    if (r.loop_closure) CHECK(r.loop_closure->bridged);
+  }
 }
 
 TEST_CASE("threaded loop closing: the two laps are closed in the loop thread and every frame follows") {

@@ -57,6 +57,8 @@ struct LoopClosingSettings {
   std::optional<bool> fuse;
   std::optional<bool> global_ba;
   std::optional<bool> merge_maps;
+  std::optional<bool> bridge;             // LoopClosing.BridgeGaps (0/1)
+  std::optional<double> bridge_max_gap_s;  // LoopClosing.BridgeMaxGap, seconds
 
   void validate() const;  // ConfigError naming the LoopClosing.* key
 };
