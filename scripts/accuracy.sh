@@ -21,6 +21,8 @@
 set -euo pipefail
 
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# shellcheck source=lib/scenario-cache.sh
+source "$repo/scripts/lib/scenario-cache.sh"
 build="$repo/build/release"
 out="$repo/build/accuracy"
 seeds="1 2 3"
@@ -127,11 +129,9 @@ if [ "$sim" = 1 ]; then
   scenarios="$(echo $scenarios)"   # one line, single spaces
   length_of() {  # a scenario's frame count: --frames, else its default from the listing
     if [ -n "$frames" ]; then echo "$frames"; return; fi
-    awk -v s="$1" '$1 == s { if (match($0, /default [0-9]+ frames/)) print substr($0, RSTART + 8, RLENGTH - 15) }' <<< "$listing"
+    scenario_length "$listing" "$1"
   }
-  # everything that shapes the written street: the simulator, the demo's options, the image writers
-  key="$(cat "$repo"/src/sim/* "$repo"/include/rgbl/sim/* "$repo"/apps/rgbl/demo_command.cpp "$repo"/src/pipeline/demo.cpp \
-    "$repo"/include/rgbl/pipeline/demo.hpp "$repo"/src/io/file_sequence.cpp | sha1sum | cut -c1-12)"
+  key="$(scenario_key "$repo")"
   echo "scenarios (seeds $seeds; cache $cache, key $key):"
   runs=()   # "name scenario frames"
   plain_default="$(length_of plain)"
@@ -149,15 +149,9 @@ if [ "$sim" = 1 ]; then
   for run in "${runs[@]}"; do
     read -r name s n <<< "$run"
     for seed in $seeds; do
-      dir="$cache/$s-s$seed-f$n-$key"
-      if [ ! -f "$dir/.complete" ]; then
-        rm -rf "$dir"
-        echo "== generate $s seed $seed, $n frames" >> "$log"
-        "$rgbl" -q demo --scenario "$s" --seed "$seed" --frames "$n" --keep "$dir" --out "$out/gen-$s-$seed" \
-          >> "$log" 2>&1 && touch "$dir/.complete" || { printf '  %-28s generation FAILED\n' "$name-s$seed"; continue; }
-        rm -rf "$out/gen-$s-$seed"
-      fi
-      track "$name-s$seed" run "$dir/sequences/00" "${extra[@]}"
+      dataset="$(scenario_dataset "$rgbl" "$cache" "$key" "$s" "$seed" "$n" "$log")" \
+        || { printf '  %-28s generation FAILED\n' "$name-s$seed"; continue; }
+      track "$name-s$seed" run "$dataset" "${extra[@]}"
     done
   done
 fi

@@ -1,0 +1,120 @@
+// rgbl_jump: a gap in a drive, tracked through. Frames 0..last are fed, then resume..end (the frames
+// between never arrive; their time passes), three ways: without a gap, with the gap, and with the gap
+// but without bridging it (MapBridgeOptions). Each run is compared with the truth (ATE over the frames
+// tracked, aligned as ATE is) and the runs with the gap with the run without it (the frames after the
+// gap, in the tracker's world, which all three start at the first frame): how much the gap costs,
+// which a truth with its own heading error (KITTI raw's OXTS) does not blur. One line per run
+// (scripts/jump-table.sh runs a table of them).
+#include "rgbl/eval/trajectory_metrics.hpp"
+#include "rgbl/pipeline/pipeline.hpp"
+#include "rgbl/tracking/system.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct Run {
+  std::vector<std::size_t> frames;                  // fed, in order
+  std::vector<rgbl::TrackResult> results;
+  std::vector<rgbl::TrajectoryPose> trajectory;     // per fed frame
+  std::vector<Eigen::Isometry3d> truth;             // T_world_cam0 per fed frame
+};
+
+Run track(const rgbl::Pipeline& pipeline, std::size_t last, std::size_t resume, bool bridge) {
+  rgbl::SystemOptions options = pipeline.system_options();
+  options.loop_closing.bridge.enabled = bridge;
+  rgbl::System system(options, pipeline.calibration(), pipeline.make_depth_source(), pipeline.make_extractor());
+  const rgbl::Sequence& sequence = pipeline.sequence();
+  Run run;
+  for (std::size_t i = 0; i < sequence.size(); ++i) {
+    if (i > last && i < resume) continue;
+    const rgbl::FrameInput input = sequence.load(i);
+    if (!input.T_world_cam0) throw std::invalid_argument(fmt::format("frame {} has no ground truth", i));
+    run.frames.push_back(i);
+    run.truth.push_back(*input.T_world_cam0);
+    run.results.push_back(system.track(pipeline.sensor_frame(input)));
+  }
+  system.finish();
+  run.trajectory = system.trajectory();
+  return run;
+}
+
+// ATE (m) over the frames tracked ok, cam0 poses against the truth.
+double ate(const Run& run, const Eigen::Isometry3d& T_cam_cam0) {
+  std::vector<Eigen::Isometry3d> estimate, truth;
+  for (std::size_t k = 0; k < run.trajectory.size(); ++k) {
+    if (run.trajectory[k].state != rgbl::TrackState::Ok) continue;
+    estimate.push_back(run.trajectory[k].T_world_cam * T_cam_cam0);
+    truth.push_back(run.truth[k]);
+  }
+  return rgbl::absolute_trajectory_error(estimate, truth).translation.rmse;
+}
+
+// The largest distance of a frame tracked ok from `resume` on from the same frame of the run without a gap.
+double deviation_after(const Run& run, const Run& whole, std::size_t resume) {
+  double worst = 0.0;
+  for (std::size_t k = 0; k < run.frames.size(); ++k) {
+    if (run.frames[k] < resume || run.trajectory[k].state != rgbl::TrackState::Ok) continue;
+    const Eigen::Isometry3d& a = run.trajectory[k].T_world_cam;
+    const Eigen::Isometry3d& b = whole.trajectory[run.frames[k]].T_world_cam;
+    worst = std::max(worst, (a.translation() - b.translation()).norm());
+  }
+  return worst;
+}
+
+std::string events(const Run& run) {
+  std::string out;
+  for (std::size_t k = 0; k < run.results.size(); ++k) {
+    const rgbl::TrackResult& r = run.results[k];
+    if (r.new_map) out += fmt::format(" new map at {};", run.frames[k]);
+    if (r.loop_closure) {
+      const auto& c = *r.loop_closure;
+      out += fmt::format(" {} {} with {};", c.bridged ? "bridged" : c.merged ? "merged" : "loop closed", c.frame_index,
+                         c.matched_frame_index);
+    }
+  }
+  return out.empty() ? " -" : out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Track a drive with a gap in it, with and without bridging, against the truth and the run without the gap"};
+  std::string dir;
+  std::size_t last = 0, resume = 0;
+  app.add_option("dir", dir, "Dataset folder (as `rgbl run`)")->required();
+  app.add_option("--last", last, "Last frame fed before the gap")->required();
+  app.add_option("--resume", resume, "First frame fed after the gap")->required();
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (resume <= last + 1) throw std::invalid_argument("--resume must leave a gap after --last");
+    rgbl::PipelineOptions options;
+    options.dataset = dir;
+    const rgbl::Pipeline pipeline(options);
+    if (resume >= pipeline.sequence().size()) throw std::invalid_argument("--resume beyond the last frame");
+    const Eigen::Isometry3d T_cam_cam0 = pipeline.calibration().T_cam_cam0;
+    const Run whole = track(pipeline, pipeline.sequence().size(), pipeline.sequence().size(), true);
+    const Run bridged = track(pipeline, last, resume, true);
+    const Run apart = track(pipeline, last, resume, false);
+    const auto lost = [](const Run& run) {
+      return std::count_if(run.results.begin(), run.results.end(),
+                           [](const rgbl::TrackResult& r) { return r.state != rgbl::TrackState::Ok; });
+    };
+    fmt::print("{} gap {}-{} | ATE without gap {:.3f} m | bridging: ATE {:.3f} m, off the gapless run by <= {:.3f} m, "
+               "{} not ok;{} | without: ATE {:.3f} m, <= {:.3f} m, {} not ok;{}\n",
+               dir, last + 1, resume - 1, ate(whole, T_cam_cam0), ate(bridged, T_cam_cam0),
+               deviation_after(bridged, whole, resume), lost(bridged), events(bridged), ate(apart, T_cam_cam0),
+               deviation_after(apart, whole, resume), lost(apart), events(apart));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rgbl_jump: %s\n", e.what());
+    return 1;
+  }
+}
