@@ -10,6 +10,7 @@
 #include "rgbl/tracking/system.hpp"
 
 #include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -70,16 +71,30 @@ double deviation_after(const Run& run, const Run& whole, std::size_t resume) {
   return worst;
 }
 
-std::string events(const Run& run) {
+// The new maps and closures, each closure with how far its two frames' written relative pose is from
+// the truth's (m, deg): a false bridge shows there.
+std::string events(const Run& run, const Eigen::Isometry3d& T_cam_cam0) {
+  const auto at = [&](std::size_t frame) {
+    return static_cast<std::size_t>(std::find(run.frames.begin(), run.frames.end(), frame) - run.frames.begin());
+  };
   std::string out;
   for (std::size_t k = 0; k < run.results.size(); ++k) {
     const rgbl::TrackResult& r = run.results[k];
     if (r.new_map) out += fmt::format(" new map at {};", run.frames[k]);
-    if (r.loop_closure) {
-      const auto& c = *r.loop_closure;
-      out += fmt::format(" {} {} with {};", c.bridged ? "bridged" : c.merged ? "merged" : "loop closed", c.frame_index,
-                         c.matched_frame_index);
+    if (!r.loop_closure) continue;
+    const auto& c = *r.loop_closure;
+    const std::size_t a = at(c.frame_index), b = at(c.matched_frame_index);
+    std::string error;
+    if (a < run.frames.size() && b < run.frames.size()) {
+      const Eigen::Isometry3d estimate = (run.trajectory[b].T_world_cam * T_cam_cam0).inverse() *
+                                         (run.trajectory[a].T_world_cam * T_cam_cam0);
+      const Eigen::Isometry3d truth = run.truth[b].inverse() * run.truth[a];
+      const Eigen::Isometry3d e = truth.inverse() * estimate;
+      error = fmt::format(" (pair off by {:.3f} m, {:.2f} deg)", e.translation().norm(),
+                          Eigen::AngleAxisd(e.linear()).angle() * 180.0 / 3.141592653589793);
     }
+    out += fmt::format(" {} {} with {}{};", c.bridged ? "bridged" : c.merged ? "merged" : "loop closed", c.frame_index,
+                       c.matched_frame_index, error);
   }
   return out.empty() ? " -" : out;
 }
@@ -93,6 +108,9 @@ int main(int argc, char** argv) {
   app.add_option("dir", dir, "Dataset folder (as `rgbl run`)")->required();
   app.add_option("--last", last, "Last frame fed before the gap")->required();
   app.add_option("--resume", resume, "First frame fed after the gap")->required();
+  bool per_frame = false;
+  app.add_flag("--per-frame", per_frame,
+               "Also print each frame of the bridged run against the gapless run: as written and as tracked");
   CLI11_PARSE(app, argc, argv);
   try {
     if (resume <= last + 1) throw std::invalid_argument("--resume must leave a gap after --last");
@@ -104,6 +122,17 @@ int main(int argc, char** argv) {
     const Run whole = track(pipeline, pipeline.sequence().size(), pipeline.sequence().size(), true);
     const Run bridged = track(pipeline, last, resume, true);
     const Run apart = track(pipeline, last, resume, false);
+    if (per_frame) {
+      for (std::size_t k = 0; k < bridged.frames.size(); ++k) {
+        const std::size_t f = bridged.frames[k];
+        const Eigen::Isometry3d e = bridged.trajectory[k].T_world_cam.inverse() * whole.trajectory[f].T_world_cam;
+        const Eigen::Isometry3d e0 = bridged.results[k].T_world_cam.inverse() * whole.trajectory[f].T_world_cam;
+        fmt::print("frame {}: {} vs gapless {:.3f} m {:.2f} deg; as tracked {:.3f} m {:.2f} deg\n", f,
+                   rgbl::to_string(bridged.results[k].state), e.translation().norm(),
+                   Eigen::AngleAxisd(e.linear()).angle() * 57.2958, e0.translation().norm(),
+                   Eigen::AngleAxisd(e0.linear()).angle() * 57.2958);
+      }
+    }
     const auto lost = [](const Run& run) {
       return std::count_if(run.results.begin(), run.results.end(),
                            [](const rgbl::TrackResult& r) { return r.state != rgbl::TrackState::Ok; });
@@ -111,8 +140,8 @@ int main(int argc, char** argv) {
     fmt::print("{} gap {}-{} | ATE without gap {:.3f} m | bridging: ATE {:.3f} m, off the gapless run by <= {:.3f} m, "
                "{} not ok;{} | without: ATE {:.3f} m, <= {:.3f} m, {} not ok;{}\n",
                dir, last + 1, resume - 1, ate(whole, T_cam_cam0), ate(bridged, T_cam_cam0),
-               deviation_after(bridged, whole, resume), lost(bridged), events(bridged), ate(apart, T_cam_cam0),
-               deviation_after(apart, whole, resume), lost(apart), events(apart));
+               deviation_after(bridged, whole, resume), lost(bridged), events(bridged, T_cam_cam0), ate(apart, T_cam_cam0),
+               deviation_after(apart, whole, resume), lost(apart), events(apart, T_cam_cam0));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rgbl_jump: %s\n", e.what());
     return 1;
