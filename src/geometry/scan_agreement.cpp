@@ -31,26 +31,10 @@ ScanSample sample_scan(PointCloudView scan, const Eigen::Isometry3d& T_cam_lidar
 }
 
 ScanAgreement::ScanAgreement(const ScanSample& reference, double tolerance)
-    : tolerance_(static_cast<float>(tolerance)) {
-  // Voxels of twice the tolerance: every point within the tolerance of a query lies in the 2x2x2 block
-  // around it. Points are grouped by voxel in two passes: count per voxel, then place.
-  const float inv = 0.5F / tolerance_;
-  std::vector<std::uint32_t> slot_of(reference.points.size());
-  std::vector<std::uint32_t> counts;
-  index_.reserve(reference.points.size());
-  for (std::size_t i = 0; i < reference.points.size(); ++i) {
-    const auto [slot, added] =
-        index_.emplace(voxel_of(reference.points[i], inv), static_cast<std::uint32_t>(counts.size()));
-    if (added) counts.push_back(0);
-    ++counts[slot];
-    slot_of[i] = slot;
-  }
-  begin_.assign(counts.size() + 1, 0);
-  for (std::size_t s = 0; s < counts.size(); ++s) begin_[s + 1] = begin_[s] + counts[s];
-  std::vector<std::uint32_t> next(begin_.begin(), begin_.end() - 1);
-  points_.resize(reference.points.size());
-  for (std::size_t i = 0; i < reference.points.size(); ++i) points_[next[slot_of[i]]++] = reference.points[i];
-}
+    : tolerance_(static_cast<float>(tolerance)),
+      // Voxels of twice the tolerance: every point within the tolerance of a query lies in the 2x2x2
+      // block around it.
+      reference_(reference.points, 0.5F / tolerance_) {}
 
 bool ScanAgreement::lands(const Eigen::Vector3f& p) const {
   // a pose gone wild puts points anywhere: beyond 100 km (or not finite) nothing lands, and the voxel
@@ -63,10 +47,10 @@ bool ScanAgreement::lands(const Eigen::Vector3f& p) const {
   for (int dx = 0; dx <= 1; ++dx) {
     for (int dy = 0; dy <= 1; ++dy) {
       for (int dz = 0; dz <= 1; ++dz) {
-        const std::uint32_t slot = index_.find({low.x + dx, low.y + dy, low.z + dz});
+        const std::uint32_t slot = reference_.index.find({low.x + dx, low.y + dy, low.z + dz});
         if (slot == VoxelIndex::npos) continue;
-        for (std::uint32_t j = begin_[slot]; j < begin_[slot + 1]; ++j) {
-          if ((points_[j] - p).squaredNorm() <= tolerance2) return true;
+        for (std::uint32_t j = reference_.begin[slot]; j < reference_.begin[slot + 1]; ++j) {
+          if ((reference_.points[j] - p).squaredNorm() <= tolerance2) return true;
         }
       }
     }

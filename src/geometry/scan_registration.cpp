@@ -80,8 +80,8 @@ namespace {
 class PlaneGrid {
  public:
   PlaneGrid(const ScanSample& points, const ScanRegistrationOptions& options)
-      : edge_(static_cast<float>(std::max(options.coarse_distance, options.normal_radius))), inv_(1.0F / edge_) {
-    group(points.points);
+      : edge_(static_cast<float>(std::max(options.coarse_distance, options.normal_radius))), inv_(1.0F / edge_),
+        grid_(points.points, inv_) {
     fit_planes(options);
   }
 
@@ -91,7 +91,7 @@ class PlaneGrid {
     float best2 = max_distance * max_distance;
     for_neighbours(p, [&](std::uint32_t j) {
       if (!has_plane_[j]) return;
-      const float d2 = (points_[j] - p).squaredNorm();
+      const float d2 = (grid_.points[j] - p).squaredNorm();
       if (d2 < best2) {
         best2 = d2;
         best = static_cast<int>(j);
@@ -100,7 +100,7 @@ class PlaneGrid {
     return best;
   }
 
-  const Eigen::Vector3f& point(int j) const { return points_[static_cast<std::size_t>(j)]; }
+  const Eigen::Vector3f& point(int j) const { return grid_.points[static_cast<std::size_t>(j)]; }
   const Eigen::Vector3f& normal(int j) const { return normals_[static_cast<std::size_t>(j)]; }
 
  private:
@@ -112,41 +112,24 @@ class PlaneGrid {
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dz = -1; dz <= 1; ++dz) {
-          const std::uint32_t slot = index_.find({c.x + dx, c.y + dy, c.z + dz});
+          const std::uint32_t slot = grid_.index.find({c.x + dx, c.y + dy, c.z + dz});
           if (slot == VoxelIndex::npos) continue;
-          for (std::uint32_t j = begin_[slot]; j < begin_[slot + 1]; ++j) visit(j);
+          for (std::uint32_t j = grid_.begin[slot]; j < grid_.begin[slot + 1]; ++j) visit(j);
         }
       }
     }
   }
 
-  void group(const std::vector<Eigen::Vector3f>& points) {
-    std::vector<std::uint32_t> slot_of(points.size());
-    std::vector<std::uint32_t> counts;
-    index_.reserve(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const auto [slot, added] = index_.emplace(voxel_of(points[i], inv_), static_cast<std::uint32_t>(counts.size()));
-      if (added) counts.push_back(0);
-      ++counts[slot];
-      slot_of[i] = slot;
-    }
-    begin_.assign(counts.size() + 1, 0);
-    for (std::size_t s = 0; s < counts.size(); ++s) begin_[s + 1] = begin_[s] + counts[s];
-    std::vector<std::uint32_t> next(begin_.begin(), begin_.end() - 1);
-    points_.resize(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) points_[next[slot_of[i]]++] = points[i];
-  }
-
   void fit_planes(const ScanRegistrationOptions& options) {
     const auto radius2 = static_cast<float>(options.normal_radius * options.normal_radius);
-    normals_.assign(points_.size(), Eigen::Vector3f::Zero());
-    has_plane_.assign(points_.size(), false);
-    for (std::size_t i = 0; i < points_.size(); ++i) {
+    normals_.assign(grid_.points.size(), Eigen::Vector3f::Zero());
+    has_plane_.assign(grid_.points.size(), false);
+    for (std::size_t i = 0; i < grid_.points.size(); ++i) {
       Eigen::Vector3f sum = Eigen::Vector3f::Zero();
       Eigen::Matrix3f outer = Eigen::Matrix3f::Zero();
       int n = 0;
-      for_neighbours(points_[i], [&](std::uint32_t j) {
-        const Eigen::Vector3f d = points_[j] - points_[i];  // about the point: better conditioned
+      for_neighbours(grid_.points[i], [&](std::uint32_t j) {
+        const Eigen::Vector3f d = grid_.points[j] - grid_.points[i];  // about the point: better conditioned
         if (d.squaredNorm() > radius2) return;
         sum += d;
         outer += d * d.transpose();
@@ -163,9 +146,8 @@ class PlaneGrid {
   }
 
   float edge_, inv_;
-  VoxelIndex index_;
-  std::vector<std::uint32_t> begin_;
-  std::vector<Eigen::Vector3f> points_, normals_;
+  VoxelBuckets grid_;  // the points, grouped by voxel; planes per point in that order
+  std::vector<Eigen::Vector3f> normals_;
   std::vector<bool> has_plane_;
 };
 

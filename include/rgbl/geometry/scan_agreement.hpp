@@ -82,9 +82,7 @@ class ScanAgreement {
   bool lands(const Eigen::Vector3f& p) const;
 
   float tolerance_;
-  VoxelIndex index_;                    // voxel -> slot
-  std::vector<std::uint32_t> begin_;    // slot -> its points: points_[begin_[slot] .. begin_[slot + 1])
-  std::vector<Eigen::Vector3f> points_;  // the reference, grouped by voxel
+  VoxelBuckets reference_;  // the reference, grouped by voxels of twice the tolerance
 };
 
 }  // namespace rgbl

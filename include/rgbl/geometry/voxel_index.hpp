@@ -111,4 +111,31 @@ class VoxelIndex {
   int shift_ = 64;
 };
 
+// Points grouped by voxel of edge 1 / inv_size, for "which points are near p" queries: the points
+// of the voxel at `slot = index.find(key)` are points[begin[slot] .. begin[slot + 1]), in their input
+// order. Two passes (count per voxel, then place): no allocation per voxel.
+struct VoxelBuckets {
+  VoxelIndex index;
+  std::vector<std::uint32_t> begin;
+  std::vector<Eigen::Vector3f> points;
+
+  VoxelBuckets() = default;
+  VoxelBuckets(const std::vector<Eigen::Vector3f>& input, float inv_size) {
+    std::vector<std::uint32_t> slot_of(input.size());
+    std::vector<std::uint32_t> counts;
+    index.reserve(input.size());
+    for (std::size_t i = 0; i < input.size(); ++i) {
+      const auto [slot, added] = index.emplace(voxel_of(input[i], inv_size), static_cast<std::uint32_t>(counts.size()));
+      if (added) counts.push_back(0);
+      ++counts[slot];
+      slot_of[i] = slot;
+    }
+    begin.assign(counts.size() + 1, 0);
+    for (std::size_t s = 0; s < counts.size(); ++s) begin[s + 1] = begin[s] + counts[s];
+    std::vector<std::uint32_t> next(begin.begin(), begin.end() - 1);
+    points.resize(input.size());
+    for (std::size_t i = 0; i < input.size(); ++i) points[next[slot_of[i]]++] = input[i];
+  }
+};
+
 }  // namespace rgbl
