@@ -279,7 +279,8 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
       }
     }
     std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-    for (const auto& [score, T] : found) {
+    for (const auto& entry : found) {
+      const Eigen::Isometry3d& T = entry.second;  // a named reference: clang 14 cannot capture a binding
       if (seeds.size() >= options.refine_best) break;
       if (std::all_of(seeds.begin(), seeds.end(), [&](const Eigen::Isometry3d& o) { return distinct(o, T); })) {
         seeds.push_back(T);
