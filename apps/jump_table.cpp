@@ -6,6 +6,7 @@
 // which a truth with its own heading error (KITTI raw's OXTS) does not blur. One line per run
 // (scripts/jump-table.sh runs a table of them).
 #include "rgbl/eval/trajectory_metrics.hpp"
+#include "rgbl/geometry/se3.hpp"
 #include "rgbl/pipeline/pipeline.hpp"
 #include "rgbl/tracking/system.hpp"
 
@@ -16,11 +17,14 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace {
+
+double degrees(const Eigen::Matrix3d& R) { return rgbl::rotation_angle(R) * 180.0 / std::numbers::pi; }
 
 struct Run {
   std::vector<std::size_t> frames;                  // fed, in order
@@ -90,8 +94,7 @@ std::string events(const Run& run, const Eigen::Isometry3d& T_cam_cam0) {
                                          (run.trajectory[a].T_world_cam * T_cam_cam0);
       const Eigen::Isometry3d truth = run.truth[b].inverse() * run.truth[a];
       const Eigen::Isometry3d e = truth.inverse() * estimate;
-      error = fmt::format(" (pair off by {:.3f} m, {:.2f} deg)", e.translation().norm(),
-                          Eigen::AngleAxisd(e.linear()).angle() * 180.0 / 3.141592653589793);
+      error = fmt::format(" (pair off by {:.3f} m, {:.2f} deg)", e.translation().norm(), degrees(e.linear()));
     }
     out += fmt::format(" {} {} with {}{};", c.bridged ? "bridged" : c.merged ? "merged" : "loop closed", c.frame_index,
                        c.matched_frame_index, error);
@@ -102,7 +105,8 @@ std::string events(const Run& run, const Eigen::Isometry3d& T_cam_cam0) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Track a drive with a gap in it, with and without bridging, against the truth and the run without the gap"};
+  CLI::App app{
+      "Track a drive with a gap in it, with and without bridging, against the truth and the run without the gap"};
   std::string dir;
   std::size_t last = 0, resume = 0;
   app.add_option("dir", dir, "Dataset folder (as `rgbl run`)")->required();
@@ -128,9 +132,8 @@ int main(int argc, char** argv) {
         const Eigen::Isometry3d e = bridged.trajectory[k].T_world_cam.inverse() * whole.trajectory[f].T_world_cam;
         const Eigen::Isometry3d e0 = bridged.results[k].T_world_cam.inverse() * whole.trajectory[f].T_world_cam;
         fmt::print("frame {}: {} vs gapless {:.3f} m {:.2f} deg; as tracked {:.3f} m {:.2f} deg\n", f,
-                   rgbl::to_string(bridged.results[k].state), e.translation().norm(),
-                   Eigen::AngleAxisd(e.linear()).angle() * 57.2958, e0.translation().norm(),
-                   Eigen::AngleAxisd(e0.linear()).angle() * 57.2958);
+                   rgbl::to_string(bridged.results[k].state), e.translation().norm(), degrees(e.linear()),
+                   e0.translation().norm(), degrees(e0.linear()));
       }
     }
     const auto lost = [](const Run& run) {
@@ -140,7 +143,8 @@ int main(int argc, char** argv) {
     fmt::print("{} gap {}-{} | ATE without gap {:.3f} m | bridging: ATE {:.3f} m, off the gapless run by <= {:.3f} m, "
                "{} not ok;{} | without: ATE {:.3f} m, <= {:.3f} m, {} not ok;{}\n",
                dir, last + 1, resume - 1, ate(whole, T_cam_cam0), ate(bridged, T_cam_cam0),
-               deviation_after(bridged, whole, resume), lost(bridged), events(bridged, T_cam_cam0), ate(apart, T_cam_cam0),
+               deviation_after(bridged, whole, resume), lost(bridged), events(bridged, T_cam_cam0),
+               ate(apart, T_cam_cam0),
                deviation_after(apart, whole, resume), lost(apart), events(apart, T_cam_cam0));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rgbl_jump: %s\n", e.what());

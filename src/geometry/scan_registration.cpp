@@ -7,9 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -45,11 +43,12 @@ void ScanRegistrationOptions::validate() const {
   require(refine_best >= 1, "scan_registration.refine_best", ">= 1");
 }
 
-ScanSample voxel_downsample(PointCloudView scan, const Eigen::Isometry3d& T_frame_lidar, double min_range,
-                            double max_range, double voxel) {
-  require(std::isfinite(voxel) && voxel > 0.0, "voxel_downsample: voxel", "> 0 m");
-  const auto min2 = static_cast<float>(min_range * min_range);
-  const auto max2 = static_cast<float>(max_range * max_range);
+namespace {
+
+// One point per voxel of edge `voxel`: the mean of the voxel's returns within the range.
+ScanSample voxel_downsample(PointCloudView scan, const ScanRegistrationOptions& options, double voxel) {
+  const auto min2 = static_cast<float>(options.min_range * options.min_range);
+  const auto max2 = static_cast<float>(options.max_range * options.max_range);
   const auto inv = static_cast<float>(1.0 / voxel);
   VoxelIndex index;
   std::vector<Eigen::Vector3f> sums;
@@ -66,21 +65,18 @@ ScanSample voxel_downsample(PointCloudView scan, const Eigen::Isometry3d& T_fram
     sums[slot] += p;
     counts[slot] += 1.0F;
   }
-  const Eigen::Isometry3f T = T_frame_lidar.cast<float>();
   ScanSample sample;
   sample.points.reserve(sums.size());
-  for (std::size_t i = 0; i < sums.size(); ++i) sample.points.push_back(T * (sums[i] / counts[i]));
+  for (std::size_t i = 0; i < sums.size(); ++i) sample.points.push_back(sums[i] / counts[i]);
   return sample;
 }
-
-namespace {
 
 // Reference points with their planes, grouped by voxels of edge `edge` for neighbour searches within
 // that distance (the 3x3x3 block around a point holds them all).
 class PlaneGrid {
  public:
   PlaneGrid(const ScanSample& points, const ScanRegistrationOptions& options)
-      : edge_(static_cast<float>(std::max(options.coarse_distance, options.normal_radius))), inv_(1.0F / edge_),
+      : inv_(1.0F / static_cast<float>(std::max(options.coarse_distance, options.normal_radius))),
         grid_(points.points, inv_) {
     fit_planes(options);
   }
@@ -145,15 +141,17 @@ class PlaneGrid {
     }
   }
 
-  float edge_, inv_;
+  float inv_;
   VoxelBuckets grid_;  // the points, grouped by voxel; planes per point in that order
   std::vector<Eigen::Vector3f> normals_;
   std::vector<bool> has_plane_;
 };
 
-}  // namespace
-
-namespace {
+// The share of `sample`'s points that land on the reference under T (0 for an empty sample).
+double landing_share(const ScanAgreement& agreement, const ScanSample& sample, const Eigen::Isometry3d& T) {
+  if (sample.empty()) return 0.0;
+  return static_cast<double>(agreement.count(sample, T)) / static_cast<double>(sample.points.size());
+}
 
 // One ICP run from `guess`: the pose, whether it converged, the last iteration's correspondences and
 // the iterations taken; nullopt when too few correspondences or a singular system.
@@ -215,19 +213,13 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
                                                const Eigen::Isometry3d& T_reference_query_guess,
                                                const ScanRegistrationOptions& options) {
   options.validate();
-  const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
-  const ScanSample reference_points =
-      voxel_downsample(reference, identity, options.min_range, options.max_range, options.reference_voxel);
-  const ScanSample query_points =
-      voxel_downsample(query, identity, options.min_range, options.max_range, options.query_voxel);
+  const ScanSample reference_points = voxel_downsample(reference, options, options.reference_voxel);
+  const ScanSample query_points = voxel_downsample(query, options, options.query_voxel);
   const PlaneGrid grid(reference_points, options);
   // the agreement is counted on the query at the reference's density
-  const ScanSample dense =
-      voxel_downsample(query, identity, options.min_range, options.max_range, options.reference_voxel);
+  const ScanSample dense = voxel_downsample(query, options, options.reference_voxel);
   const ScanAgreement agreement(reference_points, options.agreement_tolerance);
-  const auto share = [&](const Eigen::Isometry3d& T) {
-    return dense.empty() ? 0.0 : static_cast<double>(agreement.count(dense, T)) / static_cast<double>(dense.points.size());
-  };
+  const auto share = [&](const Eigen::Isometry3d& T) { return landing_share(agreement, dense, T); };
 
   // The starts: the guess moved along its own direction of travel by every multiple of along_step_m
   // within along_range_m (a car braking or speeding up in a gap), each turned about the query's
@@ -259,8 +251,7 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
   if (start_count == 1) {
     seeds.push_back(T_reference_query_guess);
   } else {
-    const ScanSample coarse =
-        voxel_downsample(query, identity, options.min_range, options.max_range, options.search_voxel);
+    const ScanSample coarse = voxel_downsample(query, options, options.search_voxel);
     ScanRegistrationOptions search = options;
     search.max_iterations = options.search_iterations;
     search.min_correspondences = std::max<std::size_t>(
@@ -274,8 +265,7 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
         start.translation() += along * travel;
         const auto run = run_icp(grid, coarse, start, search);
         if (!run) continue;
-        found.emplace_back(static_cast<double>(agreement.count(coarse, run->T)) / static_cast<double>(coarse.points.size()),
-                           run->T);
+        found.emplace_back(landing_share(agreement, coarse, run->T), run->T);
       }
     }
     std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
@@ -302,7 +292,6 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
   if (converged.empty() && !first) return std::nullopt;
 
   ScanRegistration result;
-  result.query_points = query_points.points.size();
   result.starts = static_cast<int>(start_count);
   result.converged_starts = static_cast<int>(converged.size());
   if (converged.empty()) {

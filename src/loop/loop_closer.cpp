@@ -228,6 +228,7 @@ std::optional<DetectedLoop> bridge_maps(const MapBridgeOptions& o, const Eigen::
   loop.verification.constraint = {current.id, last.id, T_last_current.inverse()};
   loop.verification.counts.inliers = static_cast<int>(r->correspondences);
   loop.place = {static_cast<std::size_t>(last.id.value), r->agreement, kBridgeSource};
+  loop.bridge = true;
   return loop;
 }
 
@@ -370,15 +371,15 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
       return candidate.value <= keyframe.value - options_.min_keyframe_gap && map.keyframe(candidate) != nullptr &&
              !current->covisibility.contains(candidate) && (options_.merge_maps || roots(candidate) == root);
     };
-    // A new map's first keyframe: bridged to the map before it if the scans register.
+    // A new map's first keyframe: bridged to the map before it if the scans register (then no place
+    // is asked for: the bridge is the merge).
+    bool bridged = false;
     const Keyframe* last = last_keyframe_.valid() ? map.keyframe(last_keyframe_) : nullptr;
     if (options_.merge_maps && options_.bridge.enabled && T_cam_lidar_ && last != nullptr && !current->parent.valid() &&
         roots(last_keyframe_) != root && !scan.empty() && !last_scan_.empty()) {
       ++stats_.bridge_attempts;
-      if (auto bridged = bridge_maps(options_.bridge, *T_cam_lidar_, *last, last_scan_, *current, scan)) {
-        best = std::move(bridged);
-        step.consistent = true;
-      }
+      best = bridge_maps(options_.bridge, *T_cam_lidar_, *last, last_scan_, *current, scan);
+      bridged = best.has_value();
     }
     std::vector<std::size_t> neighbours;
     for (const KeyframeId k : map.best_covisible(keyframe, options_.place_neighbours)) {
@@ -389,7 +390,11 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
     // recogniser's best in turn: its first, then every second, and so on; a place two name is
     // verified once.
     std::vector<std::vector<PlaceCandidate>> proposed;
-    for (const auto& recognizer : places_) proposed.push_back(recognizer->query(query, allowed, options_.max_candidates));
+    if (!bridged) {
+      for (const auto& recognizer : places_) {
+        proposed.push_back(recognizer->query(query, allowed, options_.max_candidates));
+      }
+    }
     std::vector<PlaceCandidate> candidates;
     for (std::size_t rank = 0; rank < options_.max_candidates; ++rank) {
       for (const auto& list : proposed) {
@@ -400,7 +405,6 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
         }
       }
     }
-    if (step.consistent) candidates.clear();  // bridged: a merge already
     for (const PlaceCandidate& place : candidates) {
       const KeyframeId candidate{static_cast<int>(place.id)};
       ++step.candidates;
@@ -424,10 +428,11 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
         continue;
       }
       if (!best || verified->counts.inliers > best->verification.counts.inliers) {
-        best = DetectedLoop{keyframe, std::move(*verified), place, {}};
+        best = DetectedLoop{keyframe, std::move(*verified), place, {}, false};
       }
     }
-    if (best && !step.consistent) {
+    step.consistent = bridged;
+    if (best && !bridged) {
       std::vector<KeyframeId> previous;  // the newest live ones, newest first
       for (auto it = recent_.rbegin();
            it != recent_.rend() && std::cmp_less(previous.size() + 1, options_.consistent_keyframes); ++it) {
@@ -465,7 +470,8 @@ void LoopCloser::correct(Map& map, const DetectedLoop& loop, LoopCloserStep& ste
   logger()->info("{}: frame {} with frame {} ({} {:.2f}, {} inliers): moved {:.2f} m, {:.2f} deg, "
                  "loop error {:.2f} -> {:.3f} m, keyframes moved up to {:.2f} m, {} landmarks fused, global BA {} "
                  "keyframes {:.0f} ms, {:.0f} ms",
-                 c.bridged ? "maps bridged" : c.merged ? "maps merged" : "loop closed", c.frame_index, c.matched_frame_index, c.place_source,
+                 c.bridged ? "maps bridged" : c.merged ? "maps merged" : "loop closed", c.frame_index,
+                 c.matched_frame_index, c.place_source,
                  c.place_similarity, c.inliers, c.correction_m, c.correction_deg, c.correction.loop_error_before_m,
                  c.correction.loop_error_after_m, c.correction.max_keyframe_shift_m, c.fused_landmarks,
                  c.global_ba_keyframes, c.global_ba_ms, c.time_ms);
@@ -511,15 +517,17 @@ void LoopCloser::apply(Map& map, const DetectedLoop& loop, LoopCloserStep& step)
     const Eigen::Isometry3d T_old_new = loop.verification.T_cam_world.inverse() * T_cam_world_before;
     merge_maps(map, root, matched, T_old_new);
     closure.merged = true;
-    closure.bridged = loop.place.source == kBridgeSource;
+    closure.bridged = loop.bridge;
     ++stats_.merges;
     stats_.bridges += closure.bridged ? 1 : 0;
   }
   closure.correction = correct_loops(map, loops_, options_.correction);
-  // Not across a bridge: its two keyframes are 10-35 m apart and share few landmarks, and the few a
+  // Not across a bridge: its two keyframes are 7-33 m apart and share few landmarks, and the few a
   // fusion finds there (7 in a foliage scenario) become the only tie between the maps in local BA,
   // which then turned the new map 6 deg about them; unfused, the new map keeps the registered pose.
-  if (options_.fuse && !closure.bridged) closure.fused_landmarks = fuse_across(map, camera_, options_, keyframe, matched);
+  if (options_.fuse && !closure.bridged) {
+    closure.fused_landmarks = fuse_across(map, camera_, options_, keyframe, matched);
+  }
   if (options_.global_ba) adjust_map(map, keyframe, closure);
   const PoseChange moved = pose_change(T_cam_world_before, *map.keyframe_pose(keyframe));
   last_centre_ = map.keyframe(keyframe)->center();  // odometry goes on from the corrected map

@@ -55,7 +55,8 @@ std::vector<rgbl::LidarPoint> roadside(bool landmarks) {
 }
 
 // The scene's points in the frame of a sensor at T_scene_sensor.
-std::vector<rgbl::LidarPoint> seen_from(const std::vector<rgbl::LidarPoint>& scene, const Eigen::Isometry3d& T_scene_sensor) {
+std::vector<rgbl::LidarPoint> seen_from(const std::vector<rgbl::LidarPoint>& scene,
+                                        const Eigen::Isometry3d& T_scene_sensor) {
   const Eigen::Isometry3f T = T_scene_sensor.inverse().cast<float>();
   std::vector<rgbl::LidarPoint> out;
   for (const rgbl::LidarPoint& p : scene) {
@@ -92,7 +93,8 @@ TEST_CASE("scan registration: a corridor leaves the along-track position open, a
   const Eigen::Isometry3d truth = rgbl::make_isometry(Eigen::Matrix3d::Identity(), {25.0, 0.0, 0.0});
   const auto reference = seen_from(scene, Eigen::Isometry3d::Identity());
   const auto query = seen_from(scene, truth);
-  const auto r = rgbl::register_scans(reference, query, rgbl::make_isometry(Eigen::Matrix3d::Identity(), {26.0, 0.3, 0.0}));
+  const Eigen::Isometry3d guess = rgbl::make_isometry(Eigen::Matrix3d::Identity(), {26.0, 0.3, 0.0});
+  const auto r = rgbl::register_scans(reference, query, guess);
   REQUIRE(r);
   INFO(fmt::format("probe loss {:.3f}, agreement {:.3f}", r->min_probe_loss, r->agreement));
   // across the road and vertically it is pinned down, along it any shift fits as well
@@ -143,7 +145,8 @@ TEST_CASE("scan registration: too little to register is no result, bad options a
   CHECK_THROWS_AS(rgbl::register_scans(few, few, Eigen::Isometry3d::Identity(), o), rgbl::ConfigError);
 }
 
-// Sequence 04's scans 32 m apart (frames 13 and 36, a 2.3 s gap the reliability test's jump makes):
+// Sequence 04's scans 32 m apart (frames 13 and 36, 2.3 s; the reliability test's jump bridges
+// frames 12 and 36):
 // from the constant-velocity guess over the gap, the registration lands on the truth and is a peak;
 // from a guess 35 m short (the same jump without the clock's gap), it slides along the road.
 TEST_CASE("scan registration on sequence 04: 32 m apart from the motion model's guess") {

@@ -95,6 +95,15 @@ Run track(const Lap& lap, const rgbl::LoopClosingOptions& loop_closing, std::vec
   return run;
 }
 
+// The frames fed for the map-merging tests: frames 60-79 of the first lap (2 s, 20 m) left out.
+std::vector<std::size_t> without_first_lap_gap(const Lap& lap) {
+  std::vector<std::size_t> fed;
+  for (std::size_t i = 0; i < lap.frames.size(); ++i) {
+    if (i < 60 || i >= 80) fed.push_back(i);
+  }
+  return fed;
+}
+
 Run track(const Lap& lap, bool loop_closing) {
   rgbl::LoopClosingOptions options;
   options.enabled = loop_closing;
@@ -296,10 +305,7 @@ TEST_CASE("map merging: a jump on the first lap starts a new map, which the seco
   const Lap& lap = two_laps();
   // frames 0-59, then 80-200: 2 s and 20 m of the first lap missing, so tracking is lost and a new map
   // starts at the motion model's guess; the second lap passes the first map's places (frames 100-159)
-  std::vector<std::size_t> fed;
-  for (std::size_t i = 0; i < lap.frames.size(); ++i) {
-    if (i < 60 || i >= 80) fed.push_back(i);
-  }
+  const std::vector<std::size_t> fed = without_first_lap_gap(lap);
   // Bridging (the scans registered across the gap) would merge the maps at once (the next test): off
   // here, so that the second lap's revisit merges them.
   rgbl::LoopClosingOptions revisit;
@@ -354,10 +360,7 @@ TEST_CASE("map merging: a jump on the first lap starts a new map, which the seco
 
 TEST_CASE("map merging: the new map after a jump is bridged to the old one by registering the scans across the gap") {
   const Lap& lap = two_laps();
-  std::vector<std::size_t> fed;  // the jump of the test above: frames 60-79 of the first lap left out
-  for (std::size_t i = 0; i < lap.frames.size(); ++i) {
-    if (i < 60 || i >= 80) fed.push_back(i);
-  }
+  const std::vector<std::size_t> fed = without_first_lap_gap(lap);  // the jump of the test above
   rgbl::LoopClosingOptions separate;
   separate.merge_maps = false;
   const Run bridged = track(lap, rgbl::LoopClosingOptions{}, fed);

