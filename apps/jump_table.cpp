@@ -5,6 +5,7 @@
 // gap, in the tracker's world, which all three start at the first frame): how much the gap costs,
 // which a truth with its own heading error (KITTI raw's OXTS) does not blur. One line per run
 // (scripts/jump-table.sh runs a table of them).
+#include "rgbl/core/log.hpp"
 #include "rgbl/eval/trajectory_metrics.hpp"
 #include "rgbl/geometry/se3.hpp"
 #include "rgbl/pipeline/pipeline.hpp"
@@ -115,7 +116,10 @@ int main(int argc, char** argv) {
   bool per_frame = false;
   app.add_flag("--per-frame", per_frame,
                "Also print each frame of the bridged run against the gapless run: as written and as tracked");
+  bool verbose = false;
+  app.add_flag("-v,--verbose", verbose, "Print the library's debug messages (why a frame was placed where it was)");
   CLI11_PARSE(app, argc, argv);
+  rgbl::logger()->set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   try {
     if (resume <= last + 1) throw std::invalid_argument("--resume must leave a gap after --last");
     rgbl::PipelineOptions options;

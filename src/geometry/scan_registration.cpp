@@ -328,4 +328,43 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
   return result;
 }
 
+void GapRegistrationOptions::validate() const {
+  const auto non_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  require(non_negative(allowance_m), "gap_registration.allowance_m", ">= 0 m");
+  require(non_negative(max_acceleration), "gap_registration.max_acceleration", ">= 0 m/s^2");
+  require(non_negative(allowance_deg), "gap_registration.allowance_deg", ">= 0 deg");
+  require(non_negative(max_turn_rate_deg_s), "gap_registration.max_turn_rate_deg_s", ">= 0 deg/s");
+  require(std::isfinite(min_probe_loss) && min_probe_loss >= 0.0 && min_probe_loss <= 1.0,
+          "gap_registration.min_probe_loss", "in [0, 1]");
+  require(std::isfinite(max_yaw_search_deg) && max_yaw_search_deg >= 0.0 && max_yaw_search_deg <= 180.0,
+          "gap_registration.max_yaw_search_deg", "in [0, 180] deg");
+  require(std::isfinite(max_along_search_m) && max_along_search_m >= 0.0 && max_along_search_m <= 100.0,
+          "gap_registration.max_along_search_m", "in [0, 100] m");
+  require(std::isfinite(max_runner_up_ratio) && max_runner_up_ratio > 0.0 && max_runner_up_ratio <= 1.0,
+          "gap_registration.max_runner_up_ratio", "in (0, 1]");
+  registration.validate();
+}
+
+std::optional<GapRegistration> register_across_gap(PointCloudView reference, PointCloudView query,
+                                                   const Eigen::Isometry3d& T_reference_query_guess, double gap_s,
+                                                   const GapRegistrationOptions& options) {
+  options.validate();
+  GapRegistration g;
+  g.allowed_m = options.allowed_m(gap_s);
+  g.allowed_deg = options.allowed_deg(gap_s);
+  ScanRegistrationOptions search = options.registration;
+  search.yaw_range_deg = std::min(g.allowed_deg, options.max_yaw_search_deg);
+  search.along_range_m = std::min(g.allowed_m, options.max_along_search_m);
+  std::optional<ScanRegistration> r = register_scans(reference, query, T_reference_query_guess, search);
+  if (!r) return std::nullopt;
+  g.registration = *r;
+  // the query's move in the reference's frame: its origin displaced, its axes turned
+  const Eigen::Isometry3d change = T_reference_query_guess.inverse() * r->T_reference_query;
+  g.moved_m = (r->T_reference_query.translation() - T_reference_query_guess.translation()).norm();
+  g.moved_deg = rotation_angle(change.linear()) * 180.0 / std::numbers::pi;
+  g.accepted = r->converged && r->min_probe_loss >= options.min_probe_loss && g.moved_m <= g.allowed_m &&
+               g.moved_deg <= g.allowed_deg && r->runner_up_agreement <= options.max_runner_up_ratio * r->agreement;
+  return g;
+}
+
 }  // namespace rgbl

@@ -22,20 +22,7 @@
 namespace rgbl {
 
 void MapBridgeOptions::validate() const {
-  const auto non_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
   require(std::isfinite(max_gap_s) && max_gap_s > 0.0, "loop_closing.bridge.max_gap_s", "> 0 s");
-  require(non_negative(allowance_m), "loop_closing.bridge.allowance_m", ">= 0 m");
-  require(non_negative(max_acceleration), "loop_closing.bridge.max_acceleration", ">= 0 m/s^2");
-  require(non_negative(allowance_deg), "loop_closing.bridge.allowance_deg", ">= 0 deg");
-  require(non_negative(max_turn_rate_deg_s), "loop_closing.bridge.max_turn_rate_deg_s", ">= 0 deg/s");
-  require(std::isfinite(min_probe_loss) && min_probe_loss >= 0.0 && min_probe_loss <= 1.0,
-          "loop_closing.bridge.min_probe_loss", "in [0, 1]");
-  require(std::isfinite(max_yaw_search_deg) && max_yaw_search_deg >= 0.0 && max_yaw_search_deg <= 180.0,
-          "loop_closing.bridge.max_yaw_search_deg", "in [0, 180] deg");
-  require(std::isfinite(max_along_search_m) && max_along_search_m >= 0.0 && max_along_search_m <= 100.0,
-          "loop_closing.bridge.max_along_search_m", "in [0, 100] m");
-  require(std::isfinite(max_runner_up_ratio) && max_runner_up_ratio > 0.0 && max_runner_up_ratio <= 1.0,
-          "loop_closing.bridge.max_runner_up_ratio", "in (0, 1]");
   registration.validate();
 }
 
@@ -198,36 +185,32 @@ std::optional<DetectedLoop> bridge_maps(const MapBridgeOptions& o, const Eigen::
                     last.id.value, current.id.value, gap, o.max_gap_s);
     return std::nullopt;
   }
-  const double allowed_m = o.allowance_m + 0.5 * o.max_acceleration * gap * gap;
-  const double allowed_deg = o.allowance_deg + o.max_turn_rate_deg_s * gap;
   const Eigen::Isometry3d T_lidar_cam = T_cam_lidar.inverse();
   const Eigen::Isometry3d T_last_current_guess = last.T_cam_world * current.T_cam_world.inverse();
-  ScanRegistrationOptions registration = o.registration;
-  registration.yaw_range_deg = std::min(allowed_deg, o.max_yaw_search_deg);
-  registration.along_range_m = std::min(allowed_m, o.max_along_search_m);
-  const auto r = register_scans(last_scan, scan, T_lidar_cam * T_last_current_guess * T_cam_lidar, registration);
-  if (!r) {
+  const auto g = register_across_gap(last_scan, scan, T_lidar_cam * T_last_current_guess * T_cam_lidar, gap,
+                                     o.registration);
+  if (!g) {
     logger()->info("bridge: frame {} onto frame {}: too little to register", current.frame_index, last.frame_index);
     return std::nullopt;
   }
-  const Eigen::Isometry3d T_last_current = T_cam_lidar * r->T_reference_query * T_lidar_cam;
+  const ScanRegistration& r = g->registration;
+  const Eigen::Isometry3d T_last_current = T_cam_lidar * r.T_reference_query * T_lidar_cam;
   const Eigen::Isometry3d T_current_world = T_last_current.inverse() * last.T_cam_world;
-  const PoseChange asked = pose_change(current.T_cam_world, T_current_world);
-  const bool accepted = r->converged && r->min_probe_loss >= o.min_probe_loss && asked.m <= allowed_m &&
-                        asked.deg <= allowed_deg && r->runner_up_agreement <= o.max_runner_up_ratio * r->agreement;
   logger()->info("bridge: frame {} onto frame {} ({:.2f} s, {:.1f} m apart): {} of {} starts converged, {} "
                  "iterations, {} correspondences, agreement {:.3f} (runner-up {:.3f}), probe loss {:.3f} (>= {:.2f}), "
                  "moves the new map {:.2f} m, {:.2f} deg (at most {:.2f} m, {:.2f} deg): {}",
-                 current.frame_index, last.frame_index, gap, T_last_current.translation().norm(), r->converged_starts,
-                 r->starts, r->iterations, r->correspondences, r->agreement, r->runner_up_agreement, r->min_probe_loss,
-                 o.min_probe_loss, asked.m, asked.deg, allowed_m, allowed_deg, accepted ? "accepted" : "refused");
+                 current.frame_index, last.frame_index, gap, T_last_current.translation().norm(), r.converged_starts,
+                 r.starts, r.iterations, r.correspondences, r.agreement, r.runner_up_agreement, r.min_probe_loss,
+                 o.registration.min_probe_loss, g->moved_m, g->moved_deg, g->allowed_m, g->allowed_deg,
+                 g->accepted ? "accepted" : "refused");
+  const bool accepted = g->accepted;
   if (!accepted) return std::nullopt;
   DetectedLoop loop;
   loop.keyframe = current.id;
   loop.verification.T_cam_world = T_current_world;
   loop.verification.constraint = {current.id, last.id, T_last_current.inverse()};
-  loop.verification.counts.inliers = static_cast<int>(r->correspondences);
-  loop.place = {static_cast<std::size_t>(last.id.value), r->agreement, kBridgeSource};
+  loop.verification.counts.inliers = static_cast<int>(r.correspondences);
+  loop.place = {static_cast<std::size_t>(last.id.value), r.agreement, kBridgeSource};
   loop.bridge = true;
   return loop;
 }

@@ -91,4 +91,48 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
                                                const Eigen::Isometry3d& T_reference_query_guess,
                                                const ScanRegistrationOptions& options = {});
 
+// A registration across a gap in the frames: from a constant-velocity guess over gap_s seconds,
+// searched as far as that guess can be off, and taken only as a clear, pinned-down optimum within
+// that reach. Used where the images alone cannot be trusted after a gap: the bridge between two maps
+// (loop closing) and the tracker's first frame after a gap (docs/loop-closing.md, "Bridging a gap").
+struct GapRegistrationOptions {
+  // What the guess over a gap of t seconds can be off, and so the most the registration may move it:
+  // allowance_m + max_acceleration t^2 / 2 and allowance_deg + max_turn_rate_deg_s t (a car braking
+  // or accelerating at 4 m/s^2; turning at 25 deg/s, a junction turn of 10 m radius at 4.5 m/s).
+  double allowance_m = 1.0;
+  double max_acceleration = 4.0;  // m/s^2
+  double allowance_deg = 2.0;
+  double max_turn_rate_deg_s = 25.0;
+  // The result must be a peak: moved 1 m along any axis it loses at least this share of the points
+  // that land (measured: 0.15-0.49 over the 28 bridges of scripts/jump-table.sh; 0.00-0.01 where ICP
+  // slides along a road it cannot place, e.g. sequence 04's jump registered from 35 m short).
+  double min_probe_loss = 0.1;
+  // The search covers what the guess can be off (the bounds above, at most these), and its winner
+  // must fit clearly better than any other optimum it found: the runner-up's share of landing points
+  // at most this share of the winner's (measured: 0-0.76 over the 28 bridges; refused at 0.80-0.99 in
+  // three runs of look-alike hedges and blocks).
+  double max_yaw_search_deg = 30.0;
+  double max_along_search_m = 6.0;
+  double max_runner_up_ratio = 0.8;
+  ScanRegistrationOptions registration;
+
+  double allowed_m(double gap_s) const { return allowance_m + 0.5 * max_acceleration * gap_s * gap_s; }
+  double allowed_deg(double gap_s) const { return allowance_deg + max_turn_rate_deg_s * gap_s; }
+  void validate() const;
+};
+
+struct GapRegistration {
+  ScanRegistration registration;  // its T_reference_query is the result
+  double moved_m = 0.0, moved_deg = 0.0;  // how far the result is from the guess (the query's origin)
+  double allowed_m = 0.0, allowed_deg = 0.0;
+  bool accepted = false;  // converged, a clear peak, and within the allowance
+};
+
+// Registers `query` onto `reference` (scans in their own LiDAR frames, z up) across a gap of gap_s
+// seconds from T_reference_query_guess. nullopt when there is too little to register. Throws
+// ConfigError on bad options.
+std::optional<GapRegistration> register_across_gap(PointCloudView reference, PointCloudView query,
+                                                   const Eigen::Isometry3d& T_reference_query_guess, double gap_s,
+                                                   const GapRegistrationOptions& options = {});
+
 }  // namespace rgbl

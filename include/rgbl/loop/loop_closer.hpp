@@ -48,27 +48,9 @@ namespace rgbl {
 struct MapBridgeOptions {
   bool enabled = true;
   double max_gap_s = 5.0;  // between the two keyframes' timestamps: beyond, the scans share too little
-  // What the constant-velocity guess over a gap of t seconds can be off, and so the most the
-  // registration may move the new map: allowance_m + max_acceleration t^2 / 2 and allowance_deg +
-  // max_turn_rate_deg_s t (a car braking or accelerating at 4 m/s^2; turning at 25 deg/s, a junction
-  // turn of 10 m radius at 4.5 m/s).
-  double allowance_m = 1.0;
-  double max_acceleration = 4.0;      // m/s^2
-  double allowance_deg = 2.0;
-  double max_turn_rate_deg_s = 25.0;
-  // The registration must be a peak: moved 1 m along any axis it loses at least this share of the
-  // points that land (measured: 0.15-0.49 over the 28 bridges of scripts/jump-table.sh; 0.00-0.01
-  // where ICP slides along a road it cannot place, e.g. sequence 04's jump registered from 35 m short;
-  // docs/loop-closing.md).
-  double min_probe_loss = 0.1;
-  // The registration searches what the guess can be off (the bounds above, at most these), and its
-  // winner must fit clearly better than any other optimum it found: the runner-up's share of landing
-  // points at most this share of the winner's (measured: 0-0.76 over the 28 bridges; refused at
-  // 0.80-0.99 in three runs of look-alike hedges and blocks).
-  double max_yaw_search_deg = 30.0;
-  double max_along_search_m = 6.0;
-  double max_runner_up_ratio = 0.8;
-  ScanRegistrationOptions registration;
+  // What the guess over the gap can be off, how far the registration searches, and what it must
+  // pass to move the new map (a clear, pinned-down optimum within that reach).
+  GapRegistrationOptions registration;
 
   void validate() const;
 };
