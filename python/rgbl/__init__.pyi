@@ -327,6 +327,8 @@ class TrackResult:
     new_map: bool
     jump: bool
     step_rejected: bool
+    gap: bool  # the first frame after a gap in the timestamps, its scan registered onto the last one's
+    gap_registered: bool  # ...and the registration was accepted as the prediction
     inliers: int
     keypoints: int
     keypoints_with_depth: int

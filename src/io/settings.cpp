@@ -392,6 +392,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
   if (s.reference_landmark_ratio && !(*s.reference_landmark_ratio >= 0.0 && *s.reference_landmark_ratio <= 1.0))
     r.fail("Tracking.ReferenceLandmarkRatio", "a share from 0 (off) to 1");
   s.bounded_depth_error = flag("Tracking.BoundedDepthError");
+  s.register_gaps = flag("Tracking.RegisterGaps");
 
   if (!(s.projection.min_depth >= 0.0F)) r.fail("LiDAR.min_dist", "a distance >= 0 m");
   if (!(s.projection.max_depth > s.projection.min_depth))

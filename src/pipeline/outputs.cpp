@@ -169,6 +169,10 @@ std::string summary_json(const RunResult& run) {
   // steps beyond a vehicle's reach: taken on strong evidence, or rejected (the frame placed at the prediction)
   j["jump_frames"] = run.frames_where([](const TrackResult& r) { return r.jump; });
   j["rejected_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_rejected; });
+  // first frames after a gap in the timestamps whose scan was registered across it, and those where
+  // the registration was accepted as the prediction
+  j["gap_frames"] = run.frames_where([](const TrackResult& r) { return r.gap; });
+  j["registered_gap_frames"] = run.frames_where([](const TrackResult& r) { return r.gap_registered; });
   j["min_inliers_ok"] = min_inliers ? Json(*min_inliers) : Json(nullptr);
   const auto scan_age = run.scan_age_median();
   j["scan_to_image_ms"] = scan_age ? json_number(*scan_age * 1000.0) : Json(nullptr);  // median; 0: simultaneous
@@ -215,6 +219,12 @@ std::string summary_text(const RunResult& run) {
   const auto new_maps = run.frames_where([](const TrackResult& r) { return r.new_map; });
   if (!jumps.empty()) {
     fmt::format_to(out, "  steps beyond a vehicle's reach taken at frame(s) {}\n", fmt::join(jumps, ", "));
+  }
+  const auto gaps = run.frames_where([](const TrackResult& r) { return r.gap; });
+  if (!gaps.empty()) {
+    const auto registered = run.frames_where([](const TrackResult& r) { return r.gap_registered; });
+    fmt::format_to(out, "  gaps in the frames before frame(s) {}; the scans registered across the gap at: {}\n",
+                   fmt::join(gaps, ", "), registered.empty() ? "none" : fmt::format("{}", fmt::join(registered, ", ")));
   }
   if (!new_maps.empty()) {
     fmt::format_to(out, "  lost beyond relocalisation: new map started at frame(s) {}\n", fmt::join(new_maps, ", "));

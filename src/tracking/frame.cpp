@@ -19,6 +19,12 @@ FeatureExtractor make_orb_extractor(const OrbOptions& options, std::shared_ptr<T
 
 void TrackerOptions::validate() const {
   scan_sample.validate();
+  require(std::isfinite(gap_interval_ratio) && gap_interval_ratio > 1.0, "tracker.gap_interval_ratio",
+          "> 1 (times the last frame interval)");
+  require(std::isfinite(max_gap_s) && max_gap_s > 0.0, "tracker.max_gap_s", "> 0 s");
+  require(std::isfinite(gap_tolerance_m) && gap_tolerance_m > 0.0, "tracker.gap_tolerance_m", "> 0 m");
+  require(std::isfinite(gap_tolerance_deg) && gap_tolerance_deg > 0.0, "tracker.gap_tolerance_deg", "> 0 deg");
+  gap_registration.validate();
   require(std::isfinite(lidar_start_max_speed) && lidar_start_max_speed >= 0.0, "tracker.lidar_start_max_speed",
           ">= 0 m/s (0 = off)");
   require(min_initial_depth_points >= 10, "tracker.min_initial_depth_points", ">= 10");

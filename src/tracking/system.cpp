@@ -157,7 +157,7 @@ struct System::Impl {
   }
 
   Impl(SystemOptions o, CameraCalibration c, std::unique_ptr<DepthSource> d, FeatureExtractor e)
-      : options(o), calibration(c), map(o.map), tracker(map, c.camera, o.tracker), mapper(map, c.camera, o.mapping),
+      : options(o), calibration(c), map(o.map), tracker(map, c.camera, o.tracker, c.T_cam_lidar), mapper(map, c.camera, o.mapping),
         closer(c, o.loop_closing) {
     if (d) builder.emplace(c, o.depth_noise, std::move(d), std::move(e), nullptr, o.tracker.scan_sample);
     if (threaded_loop_closing()) loop_thread = std::thread([this] { run_loop_closing(); });
@@ -296,7 +296,7 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   // A loop thread's correction waits for this frame to be tracked and recorded (uncontended inline).
   const std::lock_guard gate(s.tracking_gate);
   const TrackerOutcome outcome =
-      s.tracker.track(frame, s.mapping_idle(), s.options.threaded_mapping ? s.mapping_queue.queued() : 0);
+      s.tracker.track(frame, s.mapping_idle(), s.options.threaded_mapping ? s.mapping_queue.queued() : 0, sensor.scan);
   KeyframeId new_keyframe;
   if (outcome.need_keyframe) new_keyframe = s.tracker.make_keyframe(frame);
   result.timing.tracking_ms = stage.lap_ms();
@@ -354,6 +354,8 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   result.new_map = outcome.new_map;
   result.jump = outcome.jump;
   result.step_rejected = outcome.step_rejected;
+  result.gap = outcome.gap;
+  result.gap_registered = outcome.gap_registered;
   result.inliers = outcome.inliers;
   result.keypoints = static_cast<int>(n);
   result.keypoints_with_depth = with_depth;

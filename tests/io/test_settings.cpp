@@ -211,17 +211,21 @@ TEST_CASE("settings: LocalMapping.PlaceCulling switches keyframe culling by revi
              Contains("'LocalMapping.PlaceCulling': expected 0 (off) or 1 (on)"));
 }
 
-TEST_CASE("settings: Tracking.ReferenceLandmarkRatio and Tracking.BoundedDepthError, read and validated", "[io][settings]") {
+TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError and RegisterGaps, read and validated", "[io][settings]") {
   rgbl::test::TempDir tmp;
-  const auto s = rgbl::read_settings(
-      tmp.write("t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0.25\nTracking.BoundedDepthError: 1\n"));
+  const auto s = rgbl::read_settings(tmp.write(
+      "t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0.25\nTracking.BoundedDepthError: 1\nTracking.RegisterGaps: 0\n"));
   REQUIRE(s.reference_landmark_ratio);
   CHECK(*s.reference_landmark_ratio == 0.25);
   CHECK(s.bounded_depth_error == true);
+  CHECK(s.register_gaps == false);
   CHECK(s.warnings.empty());
   const auto unset = rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n"));
   CHECK_FALSE(unset.reference_landmark_ratio);
   CHECK_FALSE(unset.bounded_depth_error);
+  CHECK_FALSE(unset.register_gaps);
+  CHECK_THAT(error_of(tmp.write("gaps.yaml", "%YAML:1.0\nTracking.RegisterGaps: yes\n")),
+             Contains("'Tracking.RegisterGaps'"));
   CHECK_THAT(error_of(tmp.write("ratio.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 1.5\n")),
              Contains("'Tracking.ReferenceLandmarkRatio': expected a share from 0 (off) to 1"));
   CHECK_THAT(error_of(tmp.write("flag.yaml", "%YAML:1.0\nTracking.BoundedDepthError: 2\n")),

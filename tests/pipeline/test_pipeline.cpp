@@ -185,10 +185,13 @@ TEST_CASE("the settings file's Tracking keys reach the tracker") {
   const rgbl::TrackerOptions defaults = rgbl::Pipeline(o).system_options().tracker;
   CHECK(defaults.reference_landmark_ratio == 0.25);
   CHECK(defaults.pose.bounded_depth_error);
-  o.settings = dir.write("t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0\nTracking.BoundedDepthError: 0\n");
+  CHECK(defaults.register_gaps);
+  o.settings = dir.write(
+      "t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0\nTracking.BoundedDepthError: 0\nTracking.RegisterGaps: 0\n");
   const rgbl::TrackerOptions set = rgbl::Pipeline(o).system_options().tracker;
   CHECK(set.reference_landmark_ratio == 0.0);
   CHECK_FALSE(set.pose.bounded_depth_error);
+  CHECK_FALSE(set.register_gaps);
 }
 
 TEST_CASE("a run that tracks nothing says so in its metrics: no figure for tracked frames") {

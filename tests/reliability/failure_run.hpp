@@ -26,6 +26,7 @@ struct Step {
   bool black = false;     // replace the image by zeros
   bool drop_scan = false;
   std::optional<std::size_t> index;  // SensorFrame index (timestamp 0.1 s x index) if not `frame`
+  std::optional<std::size_t> image_from;  // KITTI frame whose image is fed instead of `frame`'s
 };
 
 struct Outcome {
@@ -35,16 +36,14 @@ struct Outcome {
 };
 
 inline Outcome run(const std::filesystem::path& sequence, const std::vector<Step>& steps, bool threaded = false,
-                   const rgbl::LoopClosingOptions& loop_closing = {}) {
+                   rgbl::SystemOptions options = {}) {
   const auto name = [](std::size_t i) { return fmt::format("{:06}", i); };
   const cv::Mat first = rgbl::read_image_file(sequence / "image_0" / (name(0) + ".png"), rgbl::ImageMode::grey);
   const auto kitti = rgbl::read_kitti_odometry_calibration(sequence / "calib.txt", first.cols, first.rows);
   rgbl::DepthSourceContext depth;
   depth.calibration = kitti.camera(0);
   auto orb = std::make_shared<rgbl::OrbExtractor>();
-  rgbl::SystemOptions options;
   options.threaded_mapping = threaded;
-  options.loop_closing = loop_closing;
   rgbl::System system(options, depth.calibration, rgbl::make_lidar_source({}, depth),
                       [orb](const cv::Mat& g, std::vector<rgbl::Keypoint>& k, std::vector<rgbl::Descriptor>& d) {
                         orb->extract(g, k, d);
@@ -57,7 +56,8 @@ inline Outcome run(const std::filesystem::path& sequence, const std::vector<Step
     rgbl::SensorFrame frame;
     frame.index = step.index.value_or(step.frame);
     frame.timestamp = 0.1 * static_cast<double>(frame.index);
-    frame.image = rgbl::read_image_file(sequence / "image_0" / (name(step.frame) + ".png"), rgbl::ImageMode::grey);
+    frame.image = rgbl::read_image_file(sequence / "image_0" / (name(step.image_from.value_or(step.frame)) + ".png"),
+                                        rgbl::ImageMode::grey);
     REQUIRE(!frame.image.empty());
     if (step.black) frame.image = cv::Mat::zeros(frame.image.size(), CV_8UC1);
     scan.clear();

@@ -74,26 +74,24 @@ TEST_CASE("a sudden jump of 20 frames: detected, lost, a new map started and rec
   // this stretch, and fails: the frame is lost.
   CHECK(o.results[15].state == rgbl::TrackState::Lost);
   CHECK_FALSE(o.results[15].relocalised);
-  // Its pose is the constant-velocity guess over the 2.1 s gap in the timestamps (1.15 m off when
-  // this was written; the 1-frame guess would be 27.7 m off).
-  CHECK(relative_error(o, 15) < 2.0);
-  // Frame 36 is not in the map either: a new map starts there, anchored at the guess, and is recorded.
+  // Its pose is where its scan registers onto frame 14's across the 2.1 s gap in the timestamps
+  // (TrackerOptions::register_gaps; 0.26 m off when this was written), not the constant-velocity guess
+  // over the gap (1.15 m off; the 1-frame guess would be 27.7 m off).
+  CHECK(o.results[15].gap_registered);
+  CHECK(relative_error(o, 15) < 0.5);
+  // Frame 36 is not in the map either: a new map starts there, anchored at the pose frame 35 left, and
+  // is recorded.
   CHECK(o.results[16].new_map);
   CHECK(o.results[16].keyframe);
   for (std::size_t i = 16; i < o.results.size(); ++i) CHECK(o.results[i].state == rgbl::TrackState::Ok);
   for (std::size_t i = 0; i < o.results.size(); ++i) CHECK(o.results[i].new_map == (i == 16));
   // The new map's first keyframe (frame 36) is bridged to the old map: its scan registered onto the
-  // old map's last keyframe's scan (frame 12, 33 m behind) from the guess, and the new map moved onto
-  // that. The run is then one trajectory; against the run without bridging (two maps, the second where
-  // the guess put it), measured on the whole run aligned to the truth as ATE is.
+  // old map's last keyframe's scan (frame 12, 33 m behind) from where the new map was anchored, and the
+  // new map moved onto that. The run is then one trajectory.
   REQUIRE(o.results[16].loop_closure);
   CHECK(o.results[16].loop_closure->merged);
   CHECK(o.results[16].loop_closure->bridged);
-  rgbl::LoopClosingOptions no_bridge;
-  no_bridge.bridge.enabled = false;
-  const Outcome apart = run(*sequence, jump(0, 14, 35, 50), false, no_bridge);
-  for (const auto& r : apart.results) CHECK_FALSE(r.loop_closure);
-  const auto ate = [](const Outcome& run) {  // over the frames tracked (frame 35 carries the guess)
+  const auto ate = [](const Outcome& run) {  // over the frames tracked (frame 35 is lost)
     std::vector<Eigen::Isometry3d> estimate, truth;
     for (std::size_t i = 0; i < run.trajectory.size(); ++i) {
       if (run.trajectory[i].state != rgbl::TrackState::Ok) continue;
@@ -102,15 +100,35 @@ TEST_CASE("a sudden jump of 20 frames: detected, lost, a new map started and rec
     }
     return rgbl::absolute_trajectory_error(estimate, truth);
   };
-  const auto bridged = ate(o), separate = ate(apart);
-  REQUIRE(bridged.errors.size() == 30);  // frames 0-14 and 36-50
-  const double worst = *std::max_element(bridged.errors.begin() + 15, bridged.errors.end());
-  const double worst_apart = *std::max_element(separate.errors.begin() + 15, separate.errors.end());
-  WARN(fmt::format("jump bridged: ATE {:.3f} m, frames 36-50 at most {:.3f} m off; without the bridge ATE {:.3f} m, "
-                   "at most {:.3f} m", bridged.translation.rmse, worst, separate.translation.rmse, worst_apart));
+  const auto worst_after_gap = [](const rgbl::AteResult& e) {
+    REQUIRE(e.errors.size() == 30);  // frames 0-14 and 36-50
+    return *std::max_element(e.errors.begin() + 15, e.errors.end());
+  };
+  const auto bridged = ate(o);
+  const double worst = worst_after_gap(bridged);
+  // The bridge alone, where the tracker has not registered the gap (TrackerOptions::register_gaps off,
+  // as for a frame after the gap without a scan): the new map starts at the constant-velocity guess and
+  // the bridge moves it; against the same without bridging (two maps, the second where the guess put it).
+  rgbl::SystemOptions guess_only;
+  guess_only.tracker.register_gaps = false;
+  const Outcome guessed = run(*sequence, jump(0, 14, 35, 50), false, guess_only);
+  rgbl::SystemOptions neither = guess_only;
+  neither.loop_closing.bridge.enabled = false;
+  const Outcome apart = run(*sequence, jump(0, 14, 35, 50), false, neither);
+  REQUIRE(guessed.results[16].loop_closure);
+  CHECK(guessed.results[16].loop_closure->bridged);
+  CHECK_FALSE(guessed.results[15].gap);
+  CHECK(relative_error(guessed, 15) < 2.0);  // the guess over the gap
+  for (const auto& r : apart.results) CHECK_FALSE(r.loop_closure);
+  const auto bridged_guess = ate(guessed), separate = ate(apart);
+  const double worst_guess = worst_after_gap(bridged_guess), worst_apart = worst_after_gap(separate);
+  WARN(fmt::format("jump registered and bridged: ATE {:.3f} m, frames 36-50 at most {:.3f} m off; from the guess, "
+                   "bridged: {:.3f} m, at most {:.3f} m; neither: {:.3f} m, at most {:.3f} m", bridged.translation.rmse,
+                   worst, bridged_guess.translation.rmse, worst_guess, separate.translation.rmse, worst_apart));
   CHECK(worst < 0.2);
-  CHECK(worst < 0.5 * worst_apart);
-  CHECK(bridged.translation.rmse < separate.translation.rmse);
+  CHECK(worst_guess < 0.2);
+  CHECK(worst_guess < 0.5 * worst_apart);
+  CHECK(bridged_guess.translation.rmse < separate.translation.rmse);
 }
 
 TEST_CASE("a jump in the images with no gap in the clock: detected from the images alone") {
@@ -144,6 +162,35 @@ TEST_CASE("a jump in the images with no gap in the clock: detected from the imag
   const Eigen::Isometry3d est = o.trajectory[a].T_world_cam.inverse() * o.trajectory[b].T_world_cam;
   const Eigen::Isometry3d gt = o.truth[a].inverse() * o.truth[b];
   CHECK((est.translation() - gt.translation()).norm() < 1.0);
+}
+
+TEST_CASE("after a gap, images that contradict the scans' registration are not taken") {
+  const auto sequence = rgbl::test::kitti_seq04();
+  if (!sequence) return;
+  // Frames 0-30, then frame 36 after a 0.6 s gap, its scan and truth frame 36's but its image frame
+  // 10's: a place 36 m back that the map knows, where relocalisation places the image with many
+  // inliers. The scans say where the car is.
+  auto steps = frames(0, 30);
+  rgbl::test::Step odd;
+  odd.frame = 36;
+  odd.image_from = 10;
+  steps.push_back(odd);
+  const Outcome o = run(*sequence, steps);
+  INFO(states(o) << " error at 36: " << relative_error(o, 31) << " m");
+  check_complete(o);
+  const rgbl::TrackResult& r = o.results[31];
+  CHECK(r.gap_registered);
+  CHECK_FALSE(r.relocalised);
+  CHECK(r.state == rgbl::TrackState::Weak);  // placed by the scans alone
+  CHECK(r.step_rejected);
+  CHECK(relative_error(o, 31) < 0.5);
+  // Without the registration the images' relocalisation is taken, ok, 36 m back
+  rgbl::SystemOptions images_only;
+  images_only.tracker.register_gaps = false;
+  const Outcome fooled = run(*sequence, steps, false, images_only);
+  INFO("without the registration: " << states(fooled) << " error at 36: " << relative_error(fooled, 31) << " m");
+  CHECK(fooled.results[31].relocalised);
+  CHECK(relative_error(fooled, 31) > 20.0);
 }
 
 TEST_CASE("a jump back into the mapped stretch: relocalised in the map at once") {

@@ -14,6 +14,7 @@
 //   overrides the dataset's scan timestamps, 0 = simultaneous),
 //   rgbl's own Tracking.ReferenceLandmarkRatio (TrackerOptions::reference_landmark_ratio, 0..1) and
 //   Tracking.BoundedDepthError (0/1, PoseOptimizerOptions::bounded_depth_error of the tracker),
+//   Tracking.RegisterGaps (0/1, TrackerOptions::register_gaps: the scans registered across a gap),
 //   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
 //   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1), MergeMaps (0/1) (LoopClosingOptions' fields of those
 //   names).
@@ -84,6 +85,7 @@ struct Settings {
   std::optional<bool> place_culling;  // LocalMapping.PlaceCulling: keyframe culling by revisits
   std::optional<double> reference_landmark_ratio;  // Tracking.ReferenceLandmarkRatio
   std::optional<bool> bounded_depth_error;          // Tracking.BoundedDepthError
+  std::optional<bool> register_gaps;                // Tracking.RegisterGaps
   std::vector<std::string> warnings;  // unknown keys, one message each
 };
 

@@ -7,6 +7,7 @@
 #include "rgbl/backend/map_bundle.hpp"
 #include "rgbl/backend/pose_optimizer.hpp"
 #include "rgbl/geometry/scan_agreement.hpp"
+#include "rgbl/geometry/scan_registration.hpp"
 #include "rgbl/map/fusion.hpp"
 #include "rgbl/map/map.hpp"
 
@@ -142,6 +143,21 @@ struct TrackerOptions {
   // which most of those returns land on the last scan, if it beats standing still beyond chance. At 1 Hz
   // the images may offer no start near the true motion at all. 0 = off.
   double lidar_start_max_speed = 40.0;    // m/s (144 km/h)
+  // The first frame after a gap in the frames (more than gap_interval_ratio times the last frame
+  // interval and at most max_gap_s; needs both scans and the LiDAR's extrinsics): the images may find
+  // a look-alike stretch within the reach the gap allows (a hedge, identical blocks), so the scan is
+  // registered onto the last frame's across the gap (register_across_gap, as the bridge between two
+  // maps). An accepted registration replaces the constant-velocity prediction, and a pose further than
+  // gap_tolerance_m / gap_tolerance_deg from it is not taken: the local map is searched from the
+  // registered pose instead, and without an ok frame's support there the frame is weak, placed at it.
+  // The tolerance is several times the registration's error (jump table: <= 0.20 m, 0.26 deg over 24
+  // bridged pairs) and below any alias a gap lets the images take (a street's repeat, metres).
+  bool register_gaps = true;
+  double gap_interval_ratio = 2.5;
+  double max_gap_s = 5.0;
+  double gap_tolerance_m = 1.0;
+  double gap_tolerance_deg = 2.0;
+  GapRegistrationOptions gap_registration;
   bool temporary_points = true;         // last-frame depth points without landmark join the motion model
   // Keyframe decision (SPEC section 5), ORB-SLAM's but like with like: a keyframe is due when the frame
   // tracks fewer than this share of the reference keyframe's established landmarks (seen by 3

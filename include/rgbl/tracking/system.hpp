@@ -66,6 +66,10 @@ struct TrackResult {
   bool new_map = false;      // tracking was lost and a new map started here (poses anchored at a guess)
   bool jump = false;         // a step beyond a vehicle's reach, taken on strong evidence
   bool step_rejected = false;  // a step beyond a vehicle's reach on weak evidence: weak, at the prediction
+  // the first frame after a gap in the timestamps, its scan registered onto the last frame's
+  // (TrackerOptions::register_gaps); gap_registered: the registration was accepted as the prediction
+  bool gap = false;
+  bool gap_registered = false;
   int inliers = 0;           // local-map inliers (ok needs 30, 50 after a relocalisation)
   int keypoints = 0, keypoints_with_depth = 0;
   // s, the image's time minus its scan's, by which the LiDAR depth was moved (System::scan_age; 0 without)

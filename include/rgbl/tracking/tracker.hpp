@@ -10,6 +10,7 @@
 // count towards the landmarks' visible/found ratios (committed with the frame).
 
 #include "rgbl/geometry/camera.hpp"
+#include "rgbl/geometry/point_cloud.hpp"
 #include "rgbl/map/map.hpp"
 #include "rgbl/tracking/frame.hpp"
 #include "rgbl/tracking/options.hpp"
@@ -31,16 +32,24 @@ struct TrackerOutcome {
   // The pose's step from the previous frame exceeded what a vehicle can do (see check_step):
   bool jump = false;           // ...taken on strong evidence (min_jump_inliers) and reported
   bool step_rejected = false;  // ...on weak evidence: the frame is weak, placed at the prediction
+  // The first frame after a gap in the frames (TrackerOptions::register_gaps): its scan was registered
+  // onto the last frame's; gap_registered: accepted, the registration was the prediction.
+  bool gap = false;
+  bool gap_registered = false;
 };
 
 class Tracker {
  public:
-  Tracker(Map& map, const PinholeCamera& camera, TrackerOptions options);
+  // T_cam_lidar: the LiDAR's extrinsics, for registering the scans across a gap in the frames
+  // (TrackerOptions::register_gaps); none: no registration.
+  Tracker(Map& map, const PinholeCamera& camera, TrackerOptions options,
+          std::optional<Eigen::Isometry3d> T_cam_lidar = std::nullopt);
 
   // Tracks the frame (sets frame.T_cam_world, landmarks, outliers). When initialised_now or
   // need_keyframe, the caller turns the frame into a keyframe with make_keyframe(). mapping_idle and
   // keyframes_queued: local mapping's state (threaded; inline it is always idle with none queued).
-  TrackerOutcome track(Frame& frame, bool mapping_idle, std::size_t keyframes_queued = 0);
+  // scan: the frame's LiDAR scan in its own frame (empty: none), copied for the next frame.
+  TrackerOutcome track(Frame& frame, bool mapping_idle, std::size_t keyframes_queued = 0, PointCloudView scan = {});
 
   // Adds the frame as a keyframe to the map (taking the map lock) and makes it the reference.
   KeyframeId make_keyframe(const Frame& frame);
@@ -96,9 +105,18 @@ class Tracker {
   struct Prediction {
     Eigen::Isometry3d T_last_world = Eigen::Isometry3d::Identity();  // the last frame's pose
     Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();   // over the time elapsed since
+    bool gap = false;         // the first frame after a gap, its scan registered (register_gap)
+    bool registered = false;  // ...and T_cam_world is that registration
   };
 
+  TrackerOutcome track_frame(Frame& frame, bool mapping_idle, std::size_t keyframes_queued, PointCloudView scan);
   Prediction predict(const Frame& frame) const;
+  // After a gap in the frames: the prediction replaced by the scan's registration onto the last
+  // frame's, when it is accepted (TrackerOptions::register_gaps).
+  void register_gap(const Frame& frame, PointCloudView scan, Prediction& prediction) const;
+  // A pose after a gap further from the registered prediction than the gap tolerance: the local map
+  // searched from the registration instead, else the frame weak at the registered pose.
+  Hypothesis gap_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const;
   FirstHypothesis first_hypothesis(Frame frame, const Prediction& prediction, ViewLog& views) const;
   // Relocalisation against the whole map, independent of any prediction, confirmed on the local map.
   Hypothesis relocalisation_hypothesis(Frame frame, KeyframeId reference, ViewLog& views) const;
@@ -182,6 +200,8 @@ class Tracker {
   Map& map_;
   PinholeCamera camera_;
   TrackerOptions options_;
+  std::optional<Eigen::Isometry3d> T_cam_lidar_;
+  std::vector<LidarPoint> last_scan_;  // the last frame's, when gaps are registered
   TrackState state_ = TrackState::NotInitialised;
   KeyframeId reference_;
   std::size_t last_keyframe_frame_ = 0;
