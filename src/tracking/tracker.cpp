@@ -453,21 +453,26 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
       return relocalised;
     }
   }
-  views.visible.insert(views.visible.end(), candidate_views.visible.begin(), candidate_views.visible.end());
-  views.found.insert(views.found.end(), candidate_views.found.begin(), candidate_views.found.end());
   // either way the frame is at (or near) the prediction: the local map searched there is its own
   h.reference = from_prediction.reference;
-  if (plausible_alternative) {
+  settle(h, std::move(candidate), plausible_alternative, prediction.T_cam_world, candidate_views, views);
+  return h;
+}
+
+void Tracker::settle(Hypothesis& h, Frame candidate, bool take, const Eigen::Isometry3d& T_cam_world,
+                     const ViewLog& candidate_views, ViewLog& views) {
+  views.visible.insert(views.visible.end(), candidate_views.visible.begin(), candidate_views.visible.end());
+  views.found.insert(views.found.end(), candidate_views.found.begin(), candidate_views.found.end());
+  if (take) {
     h.frame = std::move(candidate);
     h.inliers = count_tracked(h.frame);
     h.weak = false;
   } else {
-    h.frame.T_cam_world = prediction.T_cam_world;
+    h.frame.T_cam_world = T_cam_world;
     clear_matches(h.frame);
     h.inliers = 0;
     h.weak = h.step_rejected = true;
   }
-  return h;
 }
 
 Tracker::Hypothesis Tracker::gap_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const {
@@ -491,21 +496,10 @@ Tracker::Hypothesis Tracker::gap_hypothesis(Hypothesis h, const Prediction& pred
                  h.frame.index, h.relocalised ? "relocalised, " : "", m, deg, options_.gap_tolerance_m,
                  options_.gap_tolerance_deg, h.inliers, local.inliers, local.visible,
                  agrees ? "taken" : "weak, at the registration");
-  views.visible.insert(views.visible.end(), candidate_views.visible.begin(), candidate_views.visible.end());
-  views.found.insert(views.found.end(), candidate_views.found.begin(), candidate_views.found.end());
   h.reference = local.reference;
   h.relocalised = false;
   h.relocalisation_frame = last_relocalisation_frame_;
-  if (agrees) {
-    h.frame = std::move(candidate);
-    h.inliers = count_tracked(h.frame);
-    h.weak = false;
-  } else {
-    h.frame.T_cam_world = prediction.T_cam_world;
-    clear_matches(h.frame);
-    h.inliers = 0;
-    h.weak = h.step_rejected = true;
-  }
+  settle(h, std::move(candidate), agrees, prediction.T_cam_world, candidate_views, views);
   return h;
 }
 

@@ -117,6 +117,10 @@ class Tracker {
   // A pose after a gap further from the registered prediction than the gap tolerance: the local map
   // searched from the registration instead, else the frame weak at the registered pose.
   Hypothesis gap_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const;
+  // The end of both: the frame as the local-map search from a pose left it (candidate, that search's
+  // views in candidate_views) when `take`, else weak at T_cam_world without matches.
+  static void settle(Hypothesis& h, Frame candidate, bool take, const Eigen::Isometry3d& T_cam_world,
+                     const ViewLog& candidate_views, ViewLog& views);
   FirstHypothesis first_hypothesis(Frame frame, const Prediction& prediction, ViewLog& views) const;
   // Relocalisation against the whole map, independent of any prediction, confirmed on the local map.
   Hypothesis relocalisation_hypothesis(Frame frame, KeyframeId reference, ViewLog& views) const;
