@@ -346,6 +346,7 @@ void GapRegistrationOptions::validate() const {
 }
 
 std::optional<GapRegistration> register_across_gap(PointCloudView reference, PointCloudView query,
+                                                   const Eigen::Isometry3d& T_cam_lidar,
                                                    const Eigen::Isometry3d& T_reference_query_guess, double gap_s,
                                                    const GapRegistrationOptions& options) {
   options.validate();
@@ -355,12 +356,15 @@ std::optional<GapRegistration> register_across_gap(PointCloudView reference, Poi
   ScanRegistrationOptions search = options.registration;
   search.yaw_range_deg = std::min(g.allowed_deg, options.max_yaw_search_deg);
   search.along_range_m = std::min(g.allowed_m, options.max_along_search_m);
-  std::optional<ScanRegistration> r = register_scans(reference, query, T_reference_query_guess, search);
+  const Eigen::Isometry3d T_lidar_cam = T_cam_lidar.inverse();
+  const Eigen::Isometry3d guess = T_lidar_cam * T_reference_query_guess * T_cam_lidar;
+  std::optional<ScanRegistration> r = register_scans(reference, query, guess, search);
   if (!r) return std::nullopt;
   g.registration = *r;
-  // the query's move in the reference's frame: its origin displaced, its axes turned
-  const Eigen::Isometry3d change = T_reference_query_guess.inverse() * r->T_reference_query;
-  g.moved_m = (r->T_reference_query.translation() - T_reference_query_guess.translation()).norm();
+  g.T_reference_query = T_cam_lidar * r->T_reference_query * T_lidar_cam;
+  // the query's move in the reference's LiDAR frame: its origin displaced, its axes turned
+  const Eigen::Isometry3d change = guess.inverse() * r->T_reference_query;
+  g.moved_m = (r->T_reference_query.translation() - guess.translation()).norm();
   g.moved_deg = rotation_angle(change.linear()) * 180.0 / std::numbers::pi;
   g.accepted = r->converged && r->min_probe_loss >= options.min_probe_loss && g.moved_m <= g.allowed_m &&
                g.moved_deg <= g.allowed_deg && r->runner_up_agreement <= options.max_runner_up_ratio * r->agreement;

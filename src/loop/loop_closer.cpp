@@ -185,16 +185,14 @@ std::optional<DetectedLoop> bridge_maps(const MapBridgeOptions& o, const Eigen::
                     last.id.value, current.id.value, gap, o.max_gap_s);
     return std::nullopt;
   }
-  const Eigen::Isometry3d T_lidar_cam = T_cam_lidar.inverse();
-  const Eigen::Isometry3d T_last_current_guess = last.T_cam_world * current.T_cam_world.inverse();
-  const auto g = register_across_gap(last_scan, scan, T_lidar_cam * T_last_current_guess * T_cam_lidar, gap,
-                                     o.registration);
+  const auto g = register_across_gap(last_scan, scan, T_cam_lidar, last.T_cam_world * current.T_cam_world.inverse(),
+                                     gap, o.registration);
   if (!g) {
     logger()->info("bridge: frame {} onto frame {}: too little to register", current.frame_index, last.frame_index);
     return std::nullopt;
   }
   const ScanRegistration& r = g->registration;
-  const Eigen::Isometry3d T_last_current = T_cam_lidar * r.T_reference_query * T_lidar_cam;
+  const Eigen::Isometry3d& T_last_current = g->T_reference_query;
   const Eigen::Isometry3d T_current_world = T_last_current.inverse() * last.T_cam_world;
   logger()->info("bridge: frame {} onto frame {} ({:.2f} s, {:.1f} m apart): {} of {} starts converged, {} "
                  "iterations, {} correspondences, agreement {:.3f} (runner-up {:.3f}), probe loss {:.3f} (>= {:.2f}), "
@@ -203,8 +201,7 @@ std::optional<DetectedLoop> bridge_maps(const MapBridgeOptions& o, const Eigen::
                  r.starts, r.iterations, r.correspondences, r.agreement, r.runner_up_agreement, r.min_probe_loss,
                  o.registration.min_probe_loss, g->moved_m, g->moved_deg, g->allowed_m, g->allowed_deg,
                  g->accepted ? "accepted" : "refused");
-  const bool accepted = g->accepted;
-  if (!accepted) return std::nullopt;
+  if (!g->accepted) return std::nullopt;
   DetectedLoop loop;
   loop.keyframe = current.id;
   loop.verification.T_cam_world = T_current_world;

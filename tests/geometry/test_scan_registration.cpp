@@ -138,8 +138,9 @@ TEST_CASE("registration across a gap: searched and accepted within what the gap 
   const auto query = seen_from(scene, truth);
   const Eigen::Isometry3d guess = rgbl::make_isometry(Eigen::Matrix3d::Identity(), {22.5, 1.2, 0.0});
   const rgbl::GapRegistrationOptions o;
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();  // the scans' frames are the "camera" frames
   // 1 s: 2 + 25 deg and 1 + 2 m allowed; the 17 deg and 1.9 m the guess is off are within, and searched
-  const auto g = rgbl::register_across_gap(reference, query, guess, 1.0, o);
+  const auto g = rgbl::register_across_gap(reference, query, I, guess, 1.0, o);
   REQUIRE(g);
   const Eigen::Isometry3d error = truth.inverse() * g->registration.T_reference_query;
   INFO(fmt::format("error {:.4f} m, moved {:.2f} m {:.2f} deg of {:.2f} m {:.2f} deg", error.translation().norm(),
@@ -151,19 +152,19 @@ TEST_CASE("registration across a gap: searched and accepted within what the gap 
   CHECK(g->moved_deg == Approx(17.19).margin(0.05));
   CHECK(g->moved_m == Approx((truth.translation() - guess.translation()).norm()).margin(0.02));
   // 0.2 s: the guess cannot be 17 deg off (7 deg allowed), so whatever the search finds is not taken
-  const auto tight = rgbl::register_across_gap(reference, query, guess, 0.2, o);
+  const auto tight = rgbl::register_across_gap(reference, query, I, guess, 0.2, o);
   CHECK((!tight || !tight->accepted));
   // a road between two rows of rails: the result slides along it, the probe refuses it
   const auto corridor = roadside(false);
   const auto slide = rgbl::register_across_gap(
       seen_from(corridor, Eigen::Isometry3d::Identity()),
-      seen_from(corridor, rgbl::make_isometry(Eigen::Matrix3d::Identity(), {25.0, 0.0, 0.0})),
+      seen_from(corridor, rgbl::make_isometry(Eigen::Matrix3d::Identity(), {25.0, 0.0, 0.0})), I,
       rgbl::make_isometry(Eigen::Matrix3d::Identity(), {26.0, 0.3, 0.0}), 1.0, o);
   REQUIRE(slide);
   CHECK_FALSE(slide->accepted);
   rgbl::GapRegistrationOptions bad;
   bad.max_runner_up_ratio = 0.0;
-  CHECK_THROWS_AS(rgbl::register_across_gap(reference, query, guess, 1.0, bad), rgbl::ConfigError);
+  CHECK_THROWS_AS(rgbl::register_across_gap(reference, query, I, guess, 1.0, bad), rgbl::ConfigError);
 }
 
 TEST_CASE("scan registration: too little to register is no result, bad options are errors") {

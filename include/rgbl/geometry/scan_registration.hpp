@@ -104,13 +104,14 @@ struct GapRegistrationOptions {
   double allowance_deg = 2.0;
   double max_turn_rate_deg_s = 25.0;
   // The result must be a peak: moved 1 m along any axis it loses at least this share of the points
-  // that land (measured: 0.15-0.49 over the 28 bridges of scripts/jump-table.sh; 0.00-0.01 where ICP
-  // slides along a road it cannot place, e.g. sequence 04's jump registered from 35 m short).
+  // that land (scripts/jump-table.sh: 0.15-0.49 over its 28 bridges and the tracker's 44 accepted
+  // registrations; 0.00-0.02 where ICP slides along a road it cannot place, e.g. sequence 04's jump
+  // registered from 35 m short).
   double min_probe_loss = 0.1;
   // The search covers what the guess can be off (the bounds above, at most these), and its winner
   // must fit clearly better than any other optimum it found: the runner-up's share of landing points
-  // at most this share of the winner's (measured: 0-0.76 over the 28 bridges; refused at 0.80-0.99 in
-  // three runs of look-alike hedges and blocks).
+  // at most this share of the winner's (the same table: 0-0.79 over those accepted; 0.82-0.99 where
+  // houses or blocks repeat along the street, refused).
   double max_yaw_search_deg = 30.0;
   double max_along_search_m = 6.0;
   double max_runner_up_ratio = 0.8;
@@ -122,16 +123,21 @@ struct GapRegistrationOptions {
 };
 
 struct GapRegistration {
-  ScanRegistration registration;  // its T_reference_query is the result
-  double moved_m = 0.0, moved_deg = 0.0;  // how far the result is from the guess (the query's origin)
+  // The result between the two camera frames (register_across_gap's T_cam_lidar), and the
+  // registration it comes from, between the LiDAR frames.
+  Eigen::Isometry3d T_reference_query = Eigen::Isometry3d::Identity();
+  ScanRegistration registration;
+  double moved_m = 0.0, moved_deg = 0.0;  // how far the result is from the guess (the LiDAR's origin)
   double allowed_m = 0.0, allowed_deg = 0.0;
   bool accepted = false;  // converged, a clear peak, and within the allowance
 };
 
 // Registers `query` onto `reference` (scans in their own LiDAR frames, z up) across a gap of gap_s
-// seconds from T_reference_query_guess. nullopt when there is too little to register. Throws
-// ConfigError on bad options.
+// seconds from T_reference_query_guess, a motion between the camera frames T_cam_lidar maps the LiDAR
+// into (both callers track cameras; identity: the LiDAR frames themselves). nullopt when there is too
+// little to register. Throws ConfigError on bad options.
 std::optional<GapRegistration> register_across_gap(PointCloudView reference, PointCloudView query,
+                                                   const Eigen::Isometry3d& T_cam_lidar,
                                                    const Eigen::Isometry3d& T_reference_query_guess, double gap_s,
                                                    const GapRegistrationOptions& options = {});
 
