@@ -113,6 +113,9 @@ int main(int argc, char** argv) {
   app.add_option("dir", dir, "Dataset folder (as `rgbl run`)")->required();
   app.add_option("--last", last, "Last frame fed before the gap")->required();
   app.add_option("--resume", resume, "First frame fed after the gap")->required();
+  std::string settings;
+  app.add_option("--settings", settings, "Settings YAML (as `rgbl run --settings`); default: the built-in settings")
+      ->check(CLI::ExistingFile);
   bool per_frame = false;
   app.add_flag("--per-frame", per_frame,
                "Also print each frame of the bridged run against the gapless run: as written and as tracked");
@@ -124,6 +127,7 @@ int main(int argc, char** argv) {
     if (resume <= last + 1) throw std::invalid_argument("--resume must leave a gap after --last");
     rgbl::PipelineOptions options;
     options.dataset = dir;
+    options.settings = settings;
     const rgbl::Pipeline pipeline(options);
     if (resume >= pipeline.sequence().size()) throw std::invalid_argument("--resume beyond the last frame");
     const Eigen::Isometry3d T_cam_cam0 = pipeline.calibration().T_cam_cam0;

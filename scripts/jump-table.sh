@@ -6,6 +6,7 @@
 # after the gap are from the run without it.
 #
 #   scripts/jump-table.sh [--build DIR] [--out FILE] [--seeds "1 2 3"] [--scenarios "a b"] [--no-real] [--no-sim]
+#                         [--settings FILE]   (a settings YAML for every run, e.g. to switch an option off)
 #
 # Data: $RGBL_DATA, else ../shared/data next to the repository; scenarios cached as scripts/accuracy.sh does.
 set -euo pipefail
@@ -19,6 +20,7 @@ seeds="1 2 3"
 scenarios=""
 real=1
 sim=1
+settings=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) build="$2"; shift 2 ;;
@@ -27,7 +29,8 @@ while [ $# -gt 0 ]; do
     --scenarios) scenarios="$2"; shift 2 ;;
     --no-real) real=0; shift ;;
     --no-sim) sim=0; shift ;;
-    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+    --settings) settings=(--settings "$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"); shift 2 ;;
+    -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
     *) echo "jump-table.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -47,7 +50,7 @@ gaps=("14 35" "29 40")
 run_gaps() {  # dataset folder
   for g in "${gaps[@]}"; do
     read -r last resume <<< "$g"
-    if ! "$jump" "$1" --last "$last" --resume "$resume" 2>> "$log" | tee -a "$out"; then
+    if ! "$jump" "$1" --last "$last" --resume "$resume" ${settings[@]+"${settings[@]}"} 2>> "$log" | tee -a "$out"; then
       echo "$1 gap $((last + 1))-$((resume - 1)): FAILED (see $log)" | tee -a "$out"
     fi
   done

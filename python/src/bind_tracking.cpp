@@ -101,6 +101,7 @@ void bind_tracking(py::module_& m) {
       .def_readonly("step_rejected", &TrackResult::step_rejected)
       .def_readonly("gap", &TrackResult::gap)
       .def_readonly("gap_registered", &TrackResult::gap_registered)
+      .def_readonly("lost_registered", &TrackResult::lost_registered)
       .def_readonly("inliers", &TrackResult::inliers, "Local-map inliers (Ok needs 30).")
       .def_readonly("keypoints", &TrackResult::keypoints)
       .def_readonly("keypoints_with_depth", &TrackResult::keypoints_with_depth)

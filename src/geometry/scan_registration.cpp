@@ -361,7 +361,9 @@ std::optional<GapRegistration> register_across_gap(PointCloudView reference, Poi
   std::optional<ScanRegistration> r = register_scans(reference, query, guess, search);
   if (!r) return std::nullopt;
   g.registration = *r;
-  g.T_reference_query = T_cam_lidar * r->T_reference_query * T_lidar_cam;
+  // a rotation to 1e-16 again: KITTI's printed extrinsics are one to ~1e-7, and the tracker chains
+  // these motions frame after frame while lost (TrackerOptions::register_lost)
+  g.T_reference_query = orthonormalized(T_cam_lidar * r->T_reference_query * T_lidar_cam);
   // the query's move in the reference's LiDAR frame: its origin displaced, its axes turned
   const Eigen::Isometry3d change = guess.inverse() * r->T_reference_query;
   g.moved_m = (r->T_reference_query.translation() - guess.translation()).norm();

@@ -85,6 +85,10 @@ Eigen::Isometry3d make_isometry(const Eigen::Matrix3d& R, const Eigen::Vector3d&
   return T;
 }
 
+Eigen::Isometry3d orthonormalized(const Eigen::Isometry3d& T) {
+  return make_isometry(Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix(), T.translation());
+}
+
 Eigen::Isometry3d isometry_from_3x4(const Matrix34d& M) {
   return make_isometry(M.leftCols<3>(), M.col(3));
 }

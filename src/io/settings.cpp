@@ -393,6 +393,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
     r.fail("Tracking.ReferenceLandmarkRatio", "a share from 0 (off) to 1");
   s.bounded_depth_error = flag("Tracking.BoundedDepthError");
   s.register_gaps = flag("Tracking.RegisterGaps");
+  s.register_lost = flag("Tracking.RegisterLost");
 
   if (!(s.projection.min_depth >= 0.0F)) r.fail("LiDAR.min_dist", "a distance >= 0 m");
   if (!(s.projection.max_depth > s.projection.min_depth))

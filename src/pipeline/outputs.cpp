@@ -173,6 +173,8 @@ std::string summary_json(const RunResult& run) {
   // the registration was accepted as the prediction
   j["gap_frames"] = run.frames_where([](const TrackResult& r) { return r.gap; });
   j["registered_gap_frames"] = run.frames_where([](const TrackResult& r) { return r.gap_registered; });
+  // lost frames placed by their scan's registration onto the last frame's (else the constant-velocity guess)
+  j["registered_lost_frames"] = run.frames_where([](const TrackResult& r) { return r.lost_registered; });
   j["min_inliers_ok"] = min_inliers ? Json(*min_inliers) : Json(nullptr);
   const auto scan_age = run.scan_age_median();
   j["scan_to_image_ms"] = scan_age ? json_number(*scan_age * 1000.0) : Json(nullptr);  // median; 0: simultaneous
@@ -225,6 +227,10 @@ std::string summary_text(const RunResult& run) {
     const auto registered = run.frames_where([](const TrackResult& r) { return r.gap_registered; });
     fmt::format_to(out, "  gaps in the frames before frame(s) {}; the scans registered across the gap at: {}\n",
                    fmt::join(gaps, ", "), registered.empty() ? "none" : fmt::format("{}", fmt::join(registered, ", ")));
+  }
+  const auto placed = run.frames_where([](const TrackResult& r) { return r.lost_registered; });
+  if (!placed.empty()) {
+    fmt::format_to(out, "  lost frame(s) placed by the scans (not the constant-velocity guess): {}\n", fmt::join(placed, ", "));
   }
   if (!new_maps.empty()) {
     fmt::format_to(out, "  lost beyond relocalisation: new map started at frame(s) {}\n", fmt::join(new_maps, ", "));

@@ -87,6 +87,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.reference_landmark_ratio) p.system.tracker.reference_landmark_ratio = *s.reference_landmark_ratio;
   if (s.bounded_depth_error) p.system.tracker.pose.bounded_depth_error = *s.bounded_depth_error;
   if (s.register_gaps) p.system.tracker.register_gaps = *s.register_gaps;
+  if (s.register_lost) p.system.tracker.register_lost = *s.register_lost;
   if (s.bf || s.th_depth) {
     p.notes.push_back("Camera.bf / ThDepth are not used: rgbl weights depth with an explicit noise model");
   }

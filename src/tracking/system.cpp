@@ -356,6 +356,7 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   result.step_rejected = outcome.step_rejected;
   result.gap = outcome.gap;
   result.gap_registered = outcome.gap_registered;
+  result.lost_registered = outcome.lost_registered;
   result.inliers = outcome.inliers;
   result.keypoints = static_cast<int>(n);
   result.keypoints_with_depth = with_depth;

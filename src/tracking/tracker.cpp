@@ -80,7 +80,7 @@ int count_tracked(const Frame& frame) {
 // check's), the chosen one is committed once: nothing but commit() and initialisation changes state.
 TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle, std::size_t keyframes_queued, PointCloudView scan) {
   TrackerOutcome outcome = track_frame(frame, mapping_idle, keyframes_queued, scan);
-  if (options_.register_gaps && T_cam_lidar_) last_scan_.assign(scan.begin(), scan.end());
+  if ((options_.register_gaps || options_.register_lost) && T_cam_lidar_) last_scan_.assign(scan.begin(), scan.end());
   return outcome;
 }
 
@@ -128,6 +128,7 @@ TrackerOutcome Tracker::track_frame(Frame& frame, bool mapping_idle, std::size_t
     const bool relocalisation_tried = first.relocalisation_tried || first.suspect;
     h = step_hypothesis(std::move(h), prediction, relocalisation_tried, views);
   }
+  if (!h.ok) register_lost(h.frame, scan, prediction);
   commit(h, prediction, first, views, mapping_idle, keyframes_queued, outcome);
   frame = std::move(h.frame);
   if (outcome.new_map) return finish_initialised(frame, outcome);
@@ -174,6 +175,29 @@ void Tracker::register_gap(const Frame& frame, PointCloudView scan, Prediction& 
                  g->accepted ? "the prediction" : "not taken", watch.elapsed_ms());
   if (!g->accepted) return;
   prediction.T_cam_world = g->T_reference_query.inverse() * prediction.T_last_world;  // T_last_cur's inverse
+  prediction.registered = true;
+}
+
+void Tracker::register_lost(const Frame& frame, PointCloudView scan, Prediction& prediction) const {
+  // a gap frame's registration was tried already, from the same guess
+  if (!options_.register_lost || prediction.gap || !T_cam_lidar_ || !last_frame_ || last_scan_.empty() ||
+      scan.empty()) {
+    return;
+  }
+  const double dt = frame.timestamp - last_frame_->timestamp;
+  if (!(dt > 0.0 && dt <= options_.max_gap_s)) return;
+  const Stopwatch watch;
+  const auto g = register_across_gap(last_scan_, scan, *T_cam_lidar_,
+                                     prediction.T_last_world * prediction.T_cam_world.inverse(), dt,
+                                     options_.gap_registration);
+  if (!g) return;
+  logger()->debug("frame {}: lost; its scan registers onto the last one {:.2f} m, {:.2f} deg from the "
+                  "constant-velocity guess (at most {:.2f} m, {:.2f} deg): runner-up {:.3f} of {:.3f}, probe loss "
+                  "{:.3f}, {} ({:.0f} ms)", frame.index, g->moved_m, g->moved_deg, g->allowed_m, g->allowed_deg,
+                  g->registration.runner_up_agreement, g->registration.agreement, g->registration.min_probe_loss,
+                  g->accepted ? "its pose" : "not taken", watch.elapsed_ms());
+  if (!g->accepted) return;
+  prediction.T_cam_world = g->T_reference_query.inverse() * prediction.T_last_world;
   prediction.registered = true;
 }
 
@@ -550,11 +574,17 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
     last_inliers_ = 0;
     frame.T_cam_world = prediction.T_cam_world;  // best guess, reported with state Lost
     clear_matches(frame);
+    if (options_.register_lost && prediction.registered && last_frame_) {
+      // the scans measured this motion, the images did not contradict it: the velocity from here on
+      velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
+      velocity_dt_ = frame.timestamp - last_frame_->timestamp;
+      outcome.lost_registered = true;
+    }
     // Lost beyond the recent-loss window and the map does not know this place: carry on in a new map
-    // anchored at the guess (as ORB-SLAM3's atlas) rather than staying lost until the camera returns.
+    // anchored at the lost pose (as ORB-SLAM3's atlas) rather than staying lost until the camera returns.
     if (was_lost && !first.recent_loss && options_.new_map_when_lost && initialise(frame, prediction.T_cam_world)) {
-      logger()->warn("frame {}: lost since frame {} and relocalisation failed: new map started at the "
-                     "constant-velocity guess", frame.index, last_ok_frame_);
+      logger()->warn("frame {}: lost since frame {} and relocalisation failed: new map started at the {}", frame.index,
+                     last_ok_frame_, outcome.lost_registered ? "scans' pose" : "constant-velocity guess");
       outcome.new_map = true;
       return;
     }

@@ -151,6 +151,16 @@ TEST_CASE("registration across a gap: searched and accepted within what the gap 
   CHECK(error.translation().norm() < 0.02);
   CHECK(g->moved_deg == Approx(17.19).margin(0.05));
   CHECK(g->moved_m == Approx((truth.translation() - guess.translation()).norm()).margin(0.02));
+  // Extrinsics printed to 7 digits (KITTI's) are a rotation to ~1e-7 only; the camera motion that
+  // comes out is one to rounding, or a tracker chaining such motions frame after frame drifts off.
+  Eigen::Isometry3d T_cam_lidar = rgbl::make_isometry(rgbl::so3_exp({1.2, -1.2, 1.2}), {0.27, -0.08, -0.06});
+  T_cam_lidar.linear() = (T_cam_lidar.linear() * 1e7).array().round() / 1e7;
+  REQUIRE(rgbl::rotation_error(T_cam_lidar.linear()) > 1e-9);
+  const auto printed = rgbl::register_across_gap(reference, query, T_cam_lidar,
+                                                 T_cam_lidar * guess * T_cam_lidar.inverse(), 1.0, o);
+  REQUIRE(printed);
+  CHECK(rgbl::rotation_error(printed->T_reference_query.linear()) < 1e-12);
+  CHECK(printed->accepted);
   // 0.2 s: the guess cannot be 17 deg off (7 deg allowed), so whatever the search finds is not taken
   const auto tight = rgbl::register_across_gap(reference, query, I, guess, 0.2, o);
   CHECK((!tight || !tight->accepted));

@@ -11,6 +11,7 @@
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
+#include <opencv2/core.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -72,15 +73,17 @@ struct Run {
 };
 
 // Tracks the lap's frames `fed` (all when empty) in that order.
-// register_gaps: the tracker's own registration across a gap in the frames (TrackerOptions).
+// register_gaps, register_lost: the tracker's own registrations across a gap in the frames and of a
+// lost frame (TrackerOptions).
 Run track(const Lap& lap, const rgbl::LoopClosingOptions& loop_closing, std::vector<std::size_t> fed = {},
-          bool register_gaps = true) {
+          bool register_gaps = true, bool register_lost = true) {
   if (fed.empty()) {
     for (std::size_t i = 0; i < lap.frames.size(); ++i) fed.push_back(i);
   }
   rgbl::SystemOptions options;
   options.loop_closing = loop_closing;
   options.tracker.register_gaps = register_gaps;
+  options.tracker.register_lost = register_lost;
   const rgbl::test::Mapped m = rgbl::test::track_frames(
       lap.calibration, fed.size(), [&](std::size_t k) -> const rgbl::FrameInput& { return lap.frames[fed[k]]; },
       options);
@@ -310,15 +313,15 @@ TEST_CASE("map merging: a jump on the first lap starts a new map, which the seco
   // starts at the motion model's guess; the second lap passes the first map's places (frames 100-159)
   const std::vector<std::size_t> fed = without_first_lap_gap(lap);
   // Bridging (the scans registered across the gap) would merge the maps at once (the next test): off
-  // here, so that the second lap's revisit merges them; and the tracker does not register the gap
-  // either (it would anchor the new map where the scans put it, test_reliability), so that the new map
-  // starts at the constant-velocity guess, as after a gap without scans.
+  // here, so that the second lap's revisit merges them; and the tracker registers neither the gap nor
+  // the lost frames (it would anchor the new map where the scans put it, test_reliability), so that the
+  // new map starts at the constant-velocity guess, as after a gap without scans.
   rgbl::LoopClosingOptions revisit;
   revisit.bridge.enabled = false;
   rgbl::LoopClosingOptions separate;
   separate.merge_maps = false;
-  const Run merged = track(lap, revisit, fed, false);
-  const Run apart = track(lap, separate, fed, false);
+  const Run merged = track(lap, revisit, fed, false, false);
+  const Run apart = track(lap, separate, fed, false, false);
 
   int new_maps = 0;
   std::optional<std::size_t> merge_at;  // fed index
@@ -369,8 +372,8 @@ TEST_CASE("map merging: the new map after a jump is bridged to the old one by re
   // the new map started at the constant-velocity guess, as above: the bridge alone moves it
   rgbl::LoopClosingOptions separate;
   separate.merge_maps = false;
-  const Run bridged = track(lap, rgbl::LoopClosingOptions{}, fed, false);
-  const Run apart = track(lap, separate, fed, false);
+  const Run bridged = track(lap, rgbl::LoopClosingOptions{}, fed, false, false);
+  const Run apart = track(lap, separate, fed, false, false);
   std::optional<std::size_t> new_map, bridge_at;  // fed indices
   for (std::size_t k = 0; k < fed.size(); ++k) {
     const auto& r = bridged.results[k];
@@ -414,20 +417,30 @@ TEST_CASE("map merging: the new map after a jump is bridged to the old one by re
   CHECK(bridged.ate < 0.2 * apart.ate);
 }
 
+namespace {
+
+// The lap's frames in order, frames first..last left out (they never arrive; their time passes).
+std::vector<std::size_t> skipping(const Lap& lap, std::size_t first, std::size_t last) {
+  std::vector<std::size_t> fed;
+  for (std::size_t i = 0; i < lap.frames.size(); ++i) {
+    if (i < first || i > last) fed.push_back(i);
+  }
+  return fed;
+}
+
+}  // namespace
+
 TEST_CASE("a gap in a bend along a hedge: the scans registered across it place the next frame, not a look-alike") {
   // `rgbl demo --scenario foliage --seed 2`: a curve along a dense hedge; frames 30-39 (1 s) never
   // arrive. The car turns 14 deg in the gap, so the constant-velocity guess is 14 deg and 1.2 m off,
   // and from it the images find the hedge 10 m along, 71 inliers (scripts/jump-table.sh found this).
   const Lap lap = generate(rgbl::scenario_options("foliage", 2));
-  std::vector<std::size_t> fed;
-  for (std::size_t i = 0; i < lap.frames.size(); ++i) {
-    if (i < 30 || i >= 40) fed.push_back(i);
-  }
+  const std::vector<std::size_t> fed = skipping(lap, 30, 39);
   const std::size_t after = 30;  // fed index of frame 40
   rgbl::LoopClosingOptions loop_closing;
   loop_closing.enabled = false;  // the tracker alone
   const Run registered = track(lap, loop_closing, fed);
-  const Run guessed = track(lap, loop_closing, fed, false);
+  const Run guessed = track(lap, loop_closing, fed, false, false);
   const auto worst_after = [&](const Run& run) {
     return *std::max_element(run.error.begin() + static_cast<std::ptrdiff_t>(after), run.error.end());
   };
@@ -446,4 +459,42 @@ TEST_CASE("a gap in a bend along a hedge: the scans registered across it place t
   CHECK(worst_after(registered) < 0.3);
   CHECK(registered.ate < 0.1);
   CHECK(guessed.error[after] > 2.0);  // what the images alone take, for the record
+}
+
+TEST_CASE("braking in a gap, then no images: the lost frames keep the scans' motion, not the speed from before") {
+  // `rgbl demo --scenario traffic --seed 1`: frames 30-39 (1 s) never arrive while the car brakes for
+  // the traffic ahead (0.7 m a frame before the gap, about 0.3 m after), and the next five images are
+  // black; their scans arrive. Frame 40's scan registers across the gap (TrackerOptions::register_gaps),
+  // then each lost frame's onto the one before (register_lost), and the velocity comes from them. With
+  // register_lost off the lost frames go on at the speed from before the gap, and so does the new map
+  // started after them.
+  Lap lap = generate(rgbl::scenario_options("traffic", 1));
+  for (std::size_t i = 40; i <= 44; ++i) {
+    lap.frames[i].images[0] = cv::Mat::zeros(lap.frames[i].images[0].size(), lap.frames[i].images[0].type());
+  }
+  const std::vector<std::size_t> fed = skipping(lap, 30, 39);
+  const std::size_t after = 30;  // fed index of frame 40
+  rgbl::LoopClosingOptions loop_closing;
+  loop_closing.enabled = false;  // the tracker alone
+  const Run placed = track(lap, loop_closing, fed);
+  const Run stale = track(lap, loop_closing, fed, true, false);
+  const auto worst = [&](const Run& run, std::size_t from, std::size_t to) {
+    return *std::max_element(run.error.begin() + static_cast<std::ptrdiff_t>(from),
+                             run.error.begin() + static_cast<std::ptrdiff_t>(to));
+  };
+  fmt::print("braking in a 1 s gap, then 5 black frames: lost frames at most {:.3f} m off, at most {:.3f} m after, "
+             "ATE {:.3f} m; at the speed from before the gap {:.3f} m, {:.3f} m, ATE {:.3f} m\n",
+             worst(placed, after, after + 5), worst(placed, after + 5, fed.size()), placed.ate,
+             worst(stale, after, after + 5), worst(stale, after + 5, fed.size()), stale.ate);
+  CHECK(placed.results[after].gap_registered);
+  for (std::size_t k = after; k < after + 5; ++k) {
+    INFO("frame " << fed[k]);
+    CHECK(placed.results[k].state == rgbl::TrackState::Lost);
+    CHECK(placed.results[k].lost_registered);
+    CHECK_FALSE(stale.results[k].lost_registered);
+  }
+  for (std::size_t k = after + 5; k < fed.size(); ++k) CHECK(placed.results[k].state == rgbl::TrackState::Ok);
+  CHECK(worst(placed, after, after + 5) < 0.3);
+  CHECK(worst(placed, after + 5, fed.size()) < 0.3);
+  CHECK(worst(stale, after, after + 5) > 1.0);  // for the record: what the stale speed does
 }

@@ -36,6 +36,10 @@ double rotation_angle(const Eigen::Matrix3d& R);
 double rotation_error(const Eigen::Matrix3d& R);
 
 Eigen::Isometry3d make_isometry(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+// T with its rotation replaced by the nearest rotation (to first order; through the unit quaternion).
+// Isometry3d::inverse() transposes: a pose off by 1e-7 (conjugated with KITTI's printed extrinsics)
+// and then composed with its own inverse, frame after frame, drifts off geometrically.
+Eigen::Isometry3d orthonormalized(const Eigen::Isometry3d& T);
 Eigen::Isometry3d isometry_from_3x4(const Matrix34d& M);
 Matrix34d to_3x4(const Eigen::Isometry3d& T);
 

@@ -15,6 +15,7 @@
 //   rgbl's own Tracking.ReferenceLandmarkRatio (TrackerOptions::reference_landmark_ratio, 0..1) and
 //   Tracking.BoundedDepthError (0/1, PoseOptimizerOptions::bounded_depth_error of the tracker),
 //   Tracking.RegisterGaps (0/1, TrackerOptions::register_gaps: the scans registered across a gap),
+//   Tracking.RegisterLost (0/1, TrackerOptions::register_lost: a lost frame placed by its scan),
 //   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
 //   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1), MergeMaps (0/1) (LoopClosingOptions' fields of those
 //   names).
@@ -86,6 +87,7 @@ struct Settings {
   std::optional<double> reference_landmark_ratio;  // Tracking.ReferenceLandmarkRatio
   std::optional<bool> bounded_depth_error;          // Tracking.BoundedDepthError
   std::optional<bool> register_gaps;                // Tracking.RegisterGaps
+  std::optional<bool> register_lost;                // Tracking.RegisterLost
   std::vector<std::string> warnings;  // unknown keys, one message each
 };
 

@@ -159,6 +159,12 @@ struct TrackerOptions {
   double gap_tolerance_m = 1.0;
   double gap_tolerance_deg = 2.0;
   GapRegistrationOptions gap_registration;
+  // A frame the images cannot place is lost; its pose is still a guess that matters: a new map started
+  // a few frames later is anchored at it. With register_lost (needs both scans and the extrinsics, as
+  // above) its scan is registered onto the last frame's, with gap_registration's checks over the time
+  // between them, and an accepted registration places it instead of the constant-velocity guess and
+  // becomes the velocity (a car braking in a gap in the frames no longer keeps its speed from before).
+  bool register_lost = true;
   bool temporary_points = true;         // last-frame depth points without landmark join the motion model
   // Keyframe decision (SPEC section 5), ORB-SLAM's but like with like: a keyframe is due when the frame
   // tracks fewer than this share of the reference keyframe's established landmarks (seen by 3

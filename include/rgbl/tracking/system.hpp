@@ -70,6 +70,8 @@ struct TrackResult {
   // (TrackerOptions::register_gaps); gap_registered: the registration was accepted as the prediction
   bool gap = false;
   bool gap_registered = false;
+  // a lost frame placed by its scan's registration onto the last frame's (TrackerOptions::register_lost)
+  bool lost_registered = false;
   int inliers = 0;           // local-map inliers (ok needs 30, 50 after a relocalisation)
   int keypoints = 0, keypoints_with_depth = 0;
   // s, the image's time minus its scan's, by which the LiDAR depth was moved (System::scan_age; 0 without)

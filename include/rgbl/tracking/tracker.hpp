@@ -36,6 +36,8 @@ struct TrackerOutcome {
   // onto the last frame's; gap_registered: accepted, the registration was the prediction.
   bool gap = false;
   bool gap_registered = false;
+  // A lost frame placed by its scan's registration onto the last frame's (TrackerOptions::register_lost)
+  bool lost_registered = false;
 };
 
 class Tracker {
@@ -114,6 +116,9 @@ class Tracker {
   // After a gap in the frames: the prediction replaced by the scan's registration onto the last
   // frame's, when it is accepted (TrackerOptions::register_gaps).
   void register_gap(const Frame& frame, PointCloudView scan, Prediction& prediction) const;
+  // A frame the images cannot place: the same registration, from the constant-velocity guess over the
+  // time since the last frame (TrackerOptions::register_lost).
+  void register_lost(const Frame& frame, PointCloudView scan, Prediction& prediction) const;
   // A pose after a gap further from the registered prediction than the gap tolerance: the local map
   // searched from the registration instead, else the frame weak at the registered pose.
   Hypothesis gap_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const;
