@@ -2,7 +2,9 @@
 # Runs the test suite under AddressSanitizer + UndefinedBehaviorSanitizer (preset asan), and the
 # threaded-mapping tests (label `threaded`) under ThreadSanitizer (preset tsan).
 # The asan test preset leaves out the long end-to-end runs (loops of 400 and 800 frames, braking in a
-# gap (80 rendered frames tracked twice; black frames on 04 register lost frames under ASan), every depth
+# gap (80 rendered frames tracked twice; black frames on 04 register lost frames under ASan), the
+# simulator's bridged merge and its gap in a bend (157 s and 50 s under ASan, 2026-12-02; the reliability
+# jump and gap tests bridge, merge and register on 04 in 26 s and 10 s), every depth
 # source over the street, the scenario runs of `rgbl demo`, a lagging mapper, the kill soak): under ASan
 # they took over half the test-seconds and run code that shorter tests run under ASan too (a closure and
 # global bundle adjustment on real keyframes, map merging, each scenario's own tests and the e2e runs,
