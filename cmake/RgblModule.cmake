@@ -12,6 +12,11 @@ function(rgbl_target_warnings target)
   if(RGBL_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
+  if(CMAKE_UNITY_BUILD AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    # GCC flags a class with a member of an anonymous-namespace type only when that type comes from an
+    # included file, which every source is in a unity batch
+    target_compile_options(${target} PRIVATE -Wno-subobject-linkage)
+  endif()
 endfunction()
 
 function(rgbl_add_module name)
