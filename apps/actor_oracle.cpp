@@ -86,7 +86,9 @@ struct Outcome {
   double keypoints_with_depth = 0.0;  // per frame, after the removal
 };
 
-Outcome track(const rgbl::SyntheticOptions& scenario, Mode mode, const std::filesystem::path& config) {
+// out: where the run's outputs go (rgbl run's files), empty for none
+Outcome track(const rgbl::SyntheticOptions& scenario, Mode mode, const std::filesystem::path& config,
+              const std::filesystem::path& out) {
   rgbl::SyntheticOptions rendered = scenario;
   if (mode == Mode::no_traffic) rendered.actors.clear();  // the street's layout does not depend on them
   const rgbl::SyntheticGenerator truth(scenario);         // where the vehicles are (nothing rendered)
@@ -131,6 +133,7 @@ Outcome track(const rgbl::SyntheticOptions& scenario, Mode mode, const std::file
   }
   system.finish();
   const rgbl::RunResult result = pipeline.collect(system, std::move(records));
+  if (!out.empty()) rgbl::write_run_outputs(result, out);
   const double n = static_cast<double>(std::max<std::size_t>(1, pipeline.frame_count()));
   outcome.ate_m = result.metrics ? result.metrics->evaluation.ate.translation.rmse : std::nan("");
   outcome.actor_keypoints /= n;
@@ -151,6 +154,8 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", seeds, "Seeds to track")->expected(1, -1);
   app.add_option("--frames", frames, "Frames (0: the scenario's own)");
   app.add_option("--config", config, "A settings YAML, as for rgbl run");
+  std::filesystem::path out;
+  app.add_option("--out", out, "Write each run's outputs (as rgbl run) to OUT/seed<N>-<as-is|no-actors|no-traffic>");
   CLI11_PARSE(app, argc, argv);
   try {
     fmt::print("| {} seed | as is: ATE m | vehicle keypoints / frame | vehicle returns | no actors: ATE m | "
@@ -163,9 +168,12 @@ int main(int argc, char** argv) {
       demo.seed = seed;
       demo.frames = frames;
       const rgbl::SyntheticOptions options = rgbl::demo_simulation(demo);
-      const Outcome as_is = track(options, Mode::as_is, config);
-      const Outcome no_actors = track(options, Mode::no_actors, config);
-      const Outcome no_traffic = track(options, Mode::no_traffic, config);
+      const auto run_dir = [&](const char* mode) {
+        return out.empty() ? out : out / fmt::format("seed{}-{}", seed, mode);
+      };
+      const Outcome as_is = track(options, Mode::as_is, config, run_dir("as-is"));
+      const Outcome no_actors = track(options, Mode::no_actors, config, run_dir("no-actors"));
+      const Outcome no_traffic = track(options, Mode::no_traffic, config, run_dir("no-traffic"));
       fmt::print("| {} | {:.3f} | {:.0f} | {:.0f} % | {:.3f} | {:.0f} | {:.3f} | {:.0f} |\n", seed, as_is.ate_m,
                  as_is.actor_keypoints, 100.0 * as_is.actor_returns, no_actors.ate_m, no_actors.keypoints_with_depth,
                  no_traffic.ate_m, no_traffic.keypoints_with_depth);

@@ -3,6 +3,7 @@
 #include "rgbl/core/cpu_dispatch.hpp"
 #include "rgbl/core/error.hpp"
 
+#include <Eigen/Cholesky>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -10,6 +11,7 @@
 #include <bit>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -586,10 +588,79 @@ struct SurfaceSample {
 struct SurfaceScratch {
   std::vector<SurfaceSample> samples;
   std::vector<std::size_t> frontier;
+  std::vector<SurfaceSample> tall;  // the plane fit's taller window
 };
 
+// The plane through the surface's samples in a window fit_rows px tall, in inverse depth, at the
+// keypoint (lookup_surface_depth); nullopt when they do not bracket the keypoint's row or are too few.
+std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius, float surface_tolerance, int fit_rows,
+                                       const Eigen::Vector2f& pixel, float surface_z, SurfaceScratch& scratch) {
+  const int cx = static_cast<int>(std::floor(pixel.x() + 0.5F)), cy = static_cast<int>(std::floor(pixel.y() + 0.5F));
+  auto& tall = scratch.tall;
+  tall.clear();
+  constexpr int kHalfWidth = 2;
+  for (int dy = -fit_rows; dy <= fit_rows; ++dy) {
+    if (cy + dy < 0 || cy + dy >= sparse.rows) continue;
+    const float* row = sparse[cy + dy];
+    for (int dx = -kHalfWidth; dx <= kHalfWidth; ++dx) {
+      if (cx + dx < 0 || cx + dx >= sparse.cols || !(row[cx + dx] > 0.0F)) continue;
+      tall.push_back({{dx, dy}, row[cx + dx], false});
+    }
+  }
+  // grown from the kernel's sample nearest the surface's depth
+  std::size_t seed = tall.size();
+  float seed_difference = std::numeric_limits<float>::max();
+  for (std::size_t i = 0; i < tall.size(); ++i) {
+    if (std::abs(tall[i].cell.dx) + std::abs(tall[i].cell.dy) > radius) continue;
+    const float difference = std::abs(tall[i].d - surface_z);
+    if (difference < seed_difference) {
+      seed_difference = difference;
+      seed = i;
+    }
+  }
+  if (seed == tall.size()) return std::nullopt;
+  tall[seed].on_surface = true;
+  auto& frontier = scratch.frontier;
+  frontier.assign(1, seed);
+  while (!frontier.empty()) {
+    const SurfaceSample t = tall[frontier.back()];
+    frontier.pop_back();
+    for (std::size_t i = 0; i < tall.size(); ++i) {
+      SurfaceSample& s = tall[i];
+      if (s.on_surface || std::abs(s.cell.dx - t.cell.dx) > 2) continue;
+      // rings lie a few rows apart: the step allowed grows with the rows between two samples
+      const float rows = std::max(1.0F, 0.5F * static_cast<float>(std::abs(s.cell.dy - t.cell.dy)));
+      if (std::abs(s.d - t.d) > surface_tolerance * rows * std::min(s.d, t.d)) continue;
+      s.on_surface = true;
+      frontier.push_back(i);
+    }
+  }
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+  float top = std::numeric_limits<float>::max(), bottom = std::numeric_limits<float>::lowest();
+  int n = 0;
+  for (const SurfaceSample& s : tall) {
+    if (!s.on_surface) continue;
+    const double ex = static_cast<double>(cx + s.cell.dx) - pixel.x(), ey = static_cast<double>(cy + s.cell.dy) - pixel.y();
+    const Eigen::Vector3d j(1.0, ex, ey);
+    normal += j * j.transpose();
+    rhs += j / static_cast<double>(s.d);
+    top = std::min(top, static_cast<float>(ey));
+    bottom = std::max(bottom, static_cast<float>(ey));
+    ++n;
+  }
+  // interpolation only: samples above and below the keypoint, at least 2 rows apart
+  if (n < 4 || top > 0.0F || bottom < 0.0F || bottom - top < 2.0F) return std::nullopt;
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(normal);
+  if (ldlt.info() != Eigen::Success) return std::nullopt;
+  const double inverse_z = ldlt.solve(rhs)(0);
+  const double z = 1.0 / inverse_z;
+  if (!std::isfinite(z) || z <= 0.0 || std::abs(z - surface_z) > 3.0 * surface_tolerance * surface_z) return std::nullopt;
+  return static_cast<float>(z);
+}
+
 KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const Cell> cells, int radius,
-                                 const Inversion& inv, float surface_tolerance, const Eigen::Vector2f& pixel,
+                                 const Inversion& inv, float surface_tolerance, int fit_rows, const Eigen::Vector2f& pixel,
                                  SurfaceScratch& scratch) {
   KeypointDepth result;
   const KernelWindow window(sparse, radius, pixel);
@@ -636,6 +707,11 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
     inverse_depths += w / s.d;
   }
   result.z = static_cast<float>(weights / inverse_depths);
+  if (fit_rows > 0) {
+    if (const auto z = fit_surface_plane(sparse, radius, surface_tolerance, fit_rows, pixel, result.z, scratch)) {
+      result.z = *z;
+    }
+  }
   result.sample_distance_px = std::sqrt(nearest2);
   result.spread = hi - lo;
   return result;
@@ -644,9 +720,10 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
 }  // namespace
 
 void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, float surface_tolerance,
-                          std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) {
+                          std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out, int fit_rows) {
   options.validate();
   require(surface_tolerance >= 0.0F && surface_tolerance < 1.0F, "lidar.surface_tolerance", "a fraction in [0, 1)");
+  require(fit_rows >= 0, "lidar surface fit rows", ">= 0 px (0 = off)");
   CV_Assert(out.size() == pixels.size());
   const Kernel kernel = options.kernel();
   const std::vector<Cell> cells = kernel_cells(kernel);
@@ -655,7 +732,7 @@ void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& 
   scratch.samples.reserve(cells.size());
   scratch.frontier.reserve(cells.size());
   for (std::size_t i = 0; i < pixels.size(); ++i) {
-    out[i] = lookup_surface_one(sparse, cells, kernel.radius(), inv, surface_tolerance, pixels[i], scratch);
+    out[i] = lookup_surface_one(sparse, cells, kernel.radius(), inv, surface_tolerance, fit_rows, pixels[i], scratch);
   }
 }
 

@@ -31,6 +31,7 @@ void LidarSourceOptions::validate() const {
   require(surface_tolerance >= 0.0F && surface_tolerance < 1.0F, "lidar.surface_tolerance", "a fraction in [0, 1)");
   require(occlusion_window_deg >= 0.0 && occlusion_window_deg < 5.0, "lidar.occlusion_window_deg", "0 (off) .. 5 deg");
   require(occlusion_ratio > 1.0F, "lidar.occlusion_ratio", "> 1");
+  require(surface_fit_window_deg >= 0.0 && surface_fit_window_deg < 5.0, "lidar.surface_fit_window_deg", "0 (off) .. 5 deg");
 }
 
 void PrecomputedSourceOptions::validate() const {
@@ -126,6 +127,7 @@ class LidarDepthSource final : public DepthSource {
         options_(options) {
     options_.validate();
     occlusion_radius_ = occlusion_radius_px(camera_.fx, options_.occlusion_window_deg);  // 0: off
+    surface_fit_rows_ = occlusion_radius_px(camera_.fy, options_.surface_fit_window_deg);  // 0: off
   }
 
   std::string_view name() const override { return "lidar"; }
@@ -151,7 +153,7 @@ class LidarDepthSource final : public DepthSource {
   void sample(std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) const override {
     if (options_.completion == CompletionMethod::dilation) {
       if (options_.keypoint_depth == KeypointDepthRule::surface_mean) {
-        lookup_surface_depth(sparse_, options_.dilation, options_.surface_tolerance, pixels, out);
+        lookup_surface_depth(sparse_, options_.dilation, options_.surface_tolerance, pixels, out, surface_fit_rows_);
       } else {
         lookup_depth(sparse_, options_.dilation, pixels, out);
       }
@@ -185,6 +187,7 @@ class LidarDepthSource final : public DepthSource {
   LidarSourceOptions options_;
   cv::Mat_<float> sparse_;
   int occlusion_radius_ = 0;  // px, from occlusion_window_deg once
+  int surface_fit_rows_ = 0;  // px, from surface_fit_window_deg once
   cv::Mat_<float> occlusion_scratch_;
   cv::Mat_<float> dense_;  // only for the dense completion methods
 };

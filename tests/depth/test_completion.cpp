@@ -236,6 +236,39 @@ TEST_CASE("surface-mean keypoint depth removes the minimum's bias on a slanted p
                   rgbl::ConfigError);
 }
 
+TEST_CASE("surface plane fit: a keypoint between two LiDAR rings on the road gets its own depth") {
+  // The same road as above (1/z = v / (350 * 1.65)), but sampled only on two rings, rows 50 and 55, as
+  // a LiDAR's rings cross it. A keypoint at row 52 has only row 50 under its diamond (radius 2).
+  const double f = 350.0, h = 1.65;
+  cv::Mat_<float> rings(90, 40, 0.0F);
+  for (const int v : {50, 55}) {
+    for (int u = 0; u < 40; ++u) rings(v, u) = static_cast<float>(f * h / v);
+  }
+  const Eigen::Vector2f pixel(20.0F, 52.0F);
+  auto depth_at = [&](const cv::Mat_<float>& sparse, const Eigen::Vector2f& p, int fit_rows) {
+    rgbl::KeypointDepth out;
+    rgbl::lookup_surface_depth(sparse, {}, 0.05F, std::span<const Eigen::Vector2f>(&p, 1),
+                               std::span<rgbl::KeypointDepth>(&out, 1), fit_rows);
+    return out;
+  };
+  // without the fit: the ring's depth, 4 % beyond the road under the keypoint
+  CHECK(depth_at(rings, pixel, 0).z == Approx(f * h / 50.0).epsilon(1e-6));
+  // with rows 49-55 in the window both rings bracket the keypoint: exact, as inverse depth is affine
+  const rgbl::KeypointDepth fitted = depth_at(rings, pixel, 3);
+  CHECK(fitted.z == Approx(f * h / 52.0).epsilon(1e-5));
+  CHECK(fitted.sample_distance_px == Approx(2.0F));  // the kernel's samples, as without the fit
+  // a window that does not reach the second ring leaves the mean as it was (no extrapolation)
+  CHECK(depth_at(rings, pixel, 2).z == Approx(f * h / 50.0).epsilon(1e-6));
+  // nor does a keypoint beyond both rings: row 56 (only row 55 under its kernel) is not interpolated
+  CHECK(depth_at(rings, Eigen::Vector2f(20.0F, 56.0F), 3).z == Approx(f * h / 55.0).epsilon(1e-6));
+  // A second surface in the window is not fitted through: the lower ring replaced by a wall twice as
+  // far (a depth step beyond the tolerance, however many rows apart), the keypoint keeps its ring's depth.
+  cv::Mat_<float> step = rings.clone();
+  for (int u = 0; u < 40; ++u) step(55, u) = static_cast<float>(2.0 * f * h / 50.0);
+  CHECK(depth_at(step, pixel, 3).z == Approx(f * h / 50.0).epsilon(1e-6));
+  CHECK_THROWS_AS(depth_at(rings, pixel, -1), rgbl::ConfigError);
+}
+
 TEST_CASE("samples behind a foreground edge in the camera's view are dropped, a slanted road is kept") {
   // A post at 10 m in columns 20-22 in front of a wall at 30 m; one wall return has landed on the
   // post itself (what a LiDAR behind the camera sees past the edge).

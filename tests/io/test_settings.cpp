@@ -190,6 +190,11 @@ TEST_CASE("settings: rgbl's LiDAR occlusion keys", "[io][settings]") {
              Contains("'LiDAR.OcclusionWindowDeg': expected 0 (off) .. 5 deg"));
   CHECK_THAT(error_of(tmp.write("r.yaml", "%YAML:1.0\nLiDAR.OcclusionRatio: 1\n")),
              Contains("'LiDAR.OcclusionRatio': expected a depth ratio > 1"));
+  const auto fit = rgbl::read_settings(tmp.write("fit.yaml", "%YAML:1.0\nLiDAR.SurfaceFitWindowDeg: 0.5\n"));
+  CHECK(fit.surface_fit_window_deg == 0.5);
+  CHECK_FALSE(unset.surface_fit_window_deg);
+  CHECK_THAT(error_of(tmp.write("f.yaml", "%YAML:1.0\nLiDAR.SurfaceFitWindowDeg: 5\n")),
+             Contains("'LiDAR.SurfaceFitWindowDeg': expected 0 (off) .. 5 deg"));
 }
 
 TEST_CASE("settings: LiDAR.TimeOffset, the image's time minus the scan's", "[io][settings]") {

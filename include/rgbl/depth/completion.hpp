@@ -79,8 +79,15 @@ KeypointDepth lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions&
 // joins row by row and a background behind an edge stays out. Weights are 1 / max(distance, 0.5 px).
 // sample_distance_px is the nearest surface sample's distance; spread is as for lookup_depth. Pixels
 // outside the image get z = 0.
+// fit_rows > 0: z comes instead from a plane fitted, in inverse depth (affine in the pixel on a plane),
+// to the samples of that surface within fit_rows px above and below (and 2 px either side), evaluated
+// at the keypoint, when they bracket its row. A LiDAR's rings sit at fixed elevations from the car, so
+// on the road a keypoint between two rings otherwise reads the nearer ring's depth, which moves with
+// the car: between two frames its depth then changes by less than the car moved (docs/accuracy.md,
+// "LiDAR rings move with the car"). The surface grows from the kernel's surface through steps of up to
+// surface_tolerance per 2 rows; the fit is kept only within 3 x surface_tolerance of the mean.
 void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, float surface_tolerance,
-                          std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out);
+                          std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out, int fit_rows = 0);
 
 // Drops the samples of `sparse` that the camera cannot see: a sample with a sample nearer by more than
 // the factor `ratio` within `radius` px (a square) lies behind a foreground edge in the camera's view.

@@ -45,6 +45,11 @@ struct LidarSourceOptions {
   // depth by less than that across the window up to ~70 m away. 0 turns the filter off.
   double occlusion_window_deg = 0.3;
   float occlusion_ratio = 1.25F;
+  // The surface-mean depth from a plane through the surface's samples within this angle above and below
+  // the keypoint (lookup_surface_depth's fit_rows; KITTI 6 px, the simulator 3 px at 0.5 deg), so that a
+  // keypoint between two LiDAR rings on the road gets its own depth and not the nearer ring's. 0 = off,
+  // the default until it is judged over several samples of the accuracy suite (docs/accuracy.md).
+  double surface_fit_window_deg = 0.0;
 
   void validate() const;
 };
