@@ -442,12 +442,12 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   // where that search ended as well: an image alias, e.g. a facade's windows, which repeat every bay
   // along the street, depth included, while the poles, trees and kerbs the scan sees do not. Asked
   // only for a step that would otherwise be taken: the vote reads the whole scan sample.
+  std::optional<LidarView> lidar;  // built once, shared by the votes below
   const auto lidar_refuses = [&] {
     if (step.translation_plausible ||
         check_step(h.frame.T_cam_world, candidate.T_cam_world, predicted_step, dt, options_).translation_plausible) {
       return false;
     }
-    std::optional<LidarView> lidar;
     // Returns as the units here: refusing a step keeps the prediction, the safe side, and a facade
     // that repeats one bay along is itself one object voting for the alias (04 --first 3 --step 10,
     // frame 43: 1259 returns against 1099 for the prediction, undecided over objects).
@@ -468,7 +468,19 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
     // frame. (A jump back into the mapped stretch: the local map, searched from a prediction 28 m off,
     // ends on a pose with 32 inliers; relocalisation places the frame on 179.)
     Hypothesis relocalised = relocalisation_hypothesis(h.frame, h.reference, views);
-    if (relocalised.ok && relocalised.inliers > h.inliers) {
+    // The relocalisation is a step too when it lands beyond a vehicle's reach: the scans that may have
+    // just refused the step judge it as well (traffic seed 3 at nFeatures 1900 with the ring plane fit,
+    // frame 54: the LiDAR voted 1010 to 238 against a 0.74 m step, then a relocalisation beside it on
+    // 261 against 255 inliers was taken, and the map was lost six frames later).
+    const auto lidar_refuses_relocalisation = [&] {
+      if (check_step(relocalised.frame.T_cam_world, prediction.T_cam_world, predicted_step, dt, options_)
+              .translation_plausible) {
+        return false;
+      }
+      return lidar_preference(lidar, h.frame, relocalised.frame.T_cam_world, prediction.T_cam_world,
+                              "the relocalisation", "the prediction", false) > 0;
+    };
+    if (relocalised.ok && relocalised.inliers > h.inliers && !lidar_refuses_relocalisation()) {
       logger()->warn("frame {}: step {:.2f} m / {:.1f} deg off the constant-velocity prediction, taken as a "
                      "relocalisation on {} inliers", h.frame.index, step.translation_m, step.rotation_deg,
                      relocalised.inliers);
