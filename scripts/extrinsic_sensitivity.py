@@ -2,14 +2,19 @@
 """How a drive's result depends on the LiDAR-camera rotation: the calibration turned by a small angle.
 
   scripts/extrinsic_sensitivity.py RGBL DRIVE AXIS DEG [DEG ...] [--features "1800 1900 2000 2100 2200"]
+                                   [--settings FILE]
 
 DRIVE is a KITTI raw drive folder (<date>/<date>_drive_NNNN_sync) or an odometry sequence folder
 (.../sequences/NN, poses in ../../poses/NN.txt). For each angle a copy of the drive is made in a
 temporary folder, every file a symlink except the LiDAR-to-camera calibration, whose rotation is
 turned by DEG degrees about the camera's AXIS (x: pitch, y: yaw, z: roll; the points are turned, so
-+x moves them up in the image). RGBL (build/release/bin/rgbl) tracks it once per ORB feature count, and
-the script prints per angle the estimated path length over the truth's and the ATE, per sample and
-their mean. Nothing in the data folder is written. Needs python3-numpy.
++x moves them up in the image). AXIS e instead raises every LiDAR point's elevation by DEG at its
+range (a rotation about p x z; 0.205 deg is the HDL-64 vertical-angle correction that CT-ICP and
+kiss-icp apply to KITTI's scans, after IMLS-SLAM): the copy's scans are rewritten, the calibration
+kept. --settings adds that file's keys (lines of a settings YAML) to every run. RGBL
+(build/release/bin/rgbl) tracks each copy once per ORB feature count, and the script prints per
+angle the estimated path length over the truth's and the ATE, per sample and their mean, and the
+mean end-point drift. Nothing in the data folder is written. Needs python3-numpy.
 """
 import json
 import os
@@ -35,8 +40,51 @@ def link_all(src, dst, skip):
             os.symlink(os.path.join(src, name), os.path.join(dst, name))
 
 
+def raise_elevation(xyz, deg):
+    """Each point turned by deg about p x z: its elevation raised, its range and azimuth kept."""
+    k = np.cross(xyz, np.array([0.0, 0.0, 1.0]))
+    norm = np.linalg.norm(k, axis=1, keepdims=True)
+    k /= np.where(norm > 0, norm, 1.0)
+    a = np.radians(deg)
+    return xyz * np.cos(a) + np.cross(k, xyz) * np.sin(a)  # k is orthogonal to p: Rodrigues' last term is 0
+
+
+def elevated_copy(drive, deg, root):
+    """A copy of the drive whose velodyne scans have every point's elevation raised by deg."""
+    drive = os.path.abspath(drive)
+    odometry = os.path.exists(os.path.join(drive, 'calib.txt'))
+    parent = os.path.dirname(drive)
+    if odometry:
+        out = os.path.join(root, 'sequences', os.path.basename(drive))
+        poses = os.path.join(os.path.dirname(parent), 'poses')
+        if os.path.isdir(poses):
+            os.makedirs(root, exist_ok=True)
+            os.symlink(poses, os.path.join(root, 'poses'))
+        scans, scans_out = os.path.join(drive, 'velodyne'), os.path.join(out, 'velodyne')
+        link_all(drive, out, {'velodyne'})
+    else:
+        day = os.path.join(root, os.path.basename(parent))
+        link_all(parent, day, {os.path.basename(drive)})
+        out = os.path.join(day, os.path.basename(drive))
+        link_all(drive, out, {'velodyne_points'})
+        velo = os.path.join(drive, 'velodyne_points')
+        link_all(velo, os.path.join(out, 'velodyne_points'), {'data'})
+        scans, scans_out = os.path.join(velo, 'data'), os.path.join(out, 'velodyne_points', 'data')
+    os.makedirs(scans_out, exist_ok=True)
+    for name in sorted(os.listdir(scans)):
+        if not name.endswith('.bin'):
+            continue
+        p = np.fromfile(os.path.join(scans, name), dtype=np.float32).reshape(-1, 4)
+        q = p.astype(np.float64)
+        q[:, :3] = raise_elevation(q[:, :3], deg)
+        q.astype(np.float32).tofile(os.path.join(scans_out, name))
+    return out
+
+
 def turned_copy(drive, axis, deg, root):
     """A copy of the drive with its LiDAR-to-camera rotation turned; returns the path to run."""
+    if axis == 'e':
+        return elevated_copy(drive, deg, root)
     drive = os.path.abspath(drive)
     R = rotation(axis, deg)
     parent = os.path.dirname(drive)
@@ -86,25 +134,32 @@ def main(argv):
         i = argv.index('--features')
         features = [int(v) for v in argv[i + 1].split()]
         argv = argv[:i] + argv[i + 2:]
-    if len(argv) < 5 or argv[3] not in ('x', 'y', 'z'):
+    settings = ''
+    if '--settings' in argv:
+        i = argv.index('--settings')
+        settings = ''.join(l.rstrip('\n') + '\n' for l in open(argv[i + 1]) if not l.startswith('%YAML'))
+        argv = argv[:i] + argv[i + 2:]
+    if len(argv) < 5 or argv[3] not in ('x', 'y', 'z', 'e'):
         sys.exit(__doc__)
     rgbl, drive, axis = argv[1], argv[2], argv[3]
     with tempfile.TemporaryDirectory() as tmp:
         for deg in [float(v) for v in argv[4:]]:
             root = os.path.join(tmp, f'{axis}{deg:+g}')
             path = turned_copy(drive, axis, deg, root)
-            ratios, ates = [], []
+            ratios, ates, drifts = [], [], []
             for n in features:
                 config = os.path.join(root, f'n{n}.yaml')
-                open(config, 'w').write(f'%YAML:1.0\nORBextractor.nFeatures: {n}\n')
+                open(config, 'w').write(f'%YAML:1.0\nORBextractor.nFeatures: {n}\n' + settings)
                 out = os.path.join(root, f'run{n}')
                 subprocess.run([rgbl, '-q', 'run', path, '--config', config, '--out', out],
                                check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
                 ratios.append(path_ratio(out))
-                ates.append(json.load(open(os.path.join(out, 'summary.json')))['metrics']['ate_rmse_m'])
-            print(f'{axis} {deg:+.2f} deg: path / truth ' + ' '.join(f'{r:.4f}' for r in ratios) +
+                metrics = json.load(open(os.path.join(out, 'summary.json')))['metrics']
+                ates.append(metrics['ate_rmse_m'])
+                drifts.append(metrics['end_point_drift_percent'])
+            print(f'{axis} {deg:+.3f} deg: path / truth ' + ' '.join(f'{r:.4f}' for r in ratios) +
                   f' (mean {np.mean(ratios):.4f}); ATE m ' + ' '.join(f'{a:.3f}' for a in ates) +
-                  f' (mean {np.mean(ates):.3f})', flush=True)
+                  f' (mean {np.mean(ates):.3f}); end-point drift mean {np.mean(drifts):.2f} %', flush=True)
 
 
 if __name__ == '__main__':
