@@ -14,6 +14,13 @@ max(1 m, 5 %), dropped by the tracker's noise model) are left out. Truth: the si
 image, or for KITTI the scans of the 10 neighbouring frames moved by the ground-truth poses (the
 median within 1 px). Also prints how many LiDAR rows the kernels hold: the minimum's bias comes from
 the rows the kernel spans. Needs python3-numpy and python3-opencv.
+
+  scripts/keypoint_depth_bias.py MODE SEQ [POSES] --fit DEG
+
+With the Python module on PYTHONPATH (build/release/python), --fit also grades the library's own
+`lidar` source (rgbl.make_lidar_source: the surface mean after the occlusion filter) against the same
+source with the ring plane fit of DEG (LiDAR.SurfaceFitWindowDeg), on the keypoints where both give
+depth, over all of them and over those the fit moves by more than 0.1 %.
 """
 import os
 import sys
@@ -78,6 +85,11 @@ def keypoint_depths(sparse, px, py):
 
 
 def main():
+    fit_deg = None
+    if '--fit' in sys.argv:
+        i = sys.argv.index('--fit')
+        fit_deg = float(sys.argv[i + 1])
+        del sys.argv[i:i + 2]
     if len(sys.argv) < 3 or sys.argv[1] not in ('real', 'sim'):
         sys.exit(__doc__)
     mode, seq = sys.argv[1], sys.argv[2]
@@ -91,6 +103,13 @@ def main():
         chosen = range(0, min(len(frames), 8))
     orb = cv2.ORB_create(2000)
     errors, rows = [], []
+    library = []  # (surface mean, plane fit) relative errors from rgbl's own lidar source
+    if fit_deg is not None:
+        import rgbl  # build/release/python on PYTHONPATH
+        first = cv2.imread(os.path.join(seq, 'image_0', frames[0]), cv2.IMREAD_GRAYSCALE)
+        camera = rgbl.PinholeCamera(P[0, 0], P[1, 1], P[0, 2], P[1, 2], first.shape[1], first.shape[0])
+        calibration = rgbl.CameraCalibration(camera, T_cam_lidar=Tr)
+        sources = (rgbl.make_lidar_source(calibration), rgbl.make_lidar_source(calibration, surface_fit_window_deg=fit_deg))
     for i in chosen:
         image = cv2.imread(os.path.join(seq, 'image_0', frames[i]), cv2.IMREAD_GRAYSCALE)
         scan = read_scan(os.path.join(seq, 'velodyne', f'{i:06d}.bin'))
@@ -106,7 +125,16 @@ def main():
         else:
             truth_image = cv2.imread(os.path.join(seq, 'depth', frames[i]), cv2.IMREAD_UNCHANGED).astype(np.float64) / 256.0
             truth_image[truth_image <= 0] = np.inf
-        for k in orb.detect(image, None):
+        keypoints = orb.detect(image, None)
+        lib = None
+        if fit_deg is not None:
+            raw = np.fromfile(os.path.join(seq, 'velodyne', f'{i:06d}.bin'), np.float32).reshape(-1, 4)
+            pixels = np.array([k.pt for k in keypoints], np.float32).reshape(-1, 2)
+            lib = []
+            for source in sources:
+                source.prepare(image, raw)
+                lib.append(source.sample(pixels)[:, 0])
+        for index, k in enumerate(keypoints):
             px, py = k.pt
             r = keypoint_depths(sparse, px, py)
             if r is None or r[2] > max(1.0, 0.05 * r[0]) or r[0] > 80:
@@ -119,6 +147,8 @@ def main():
             truth = np.median(near)
             errors.append(((r[0] - truth) / truth, (r[1] - truth) / truth))
             rows.append(r[3])
+            if lib is not None and lib[0][index] > 0 and lib[1][index] > 0:
+                library.append(((lib[0][index] - truth) / truth, (lib[1][index] - truth) / truth))
     errors = np.array(errors)
     print(f'{seq}: {len(errors)} keypoints with depth and truth (relative errors within +-20 %)')
     for column, name in ((0, 'minimum (lidar:dilated)'), (1, 'surface mean (lidar)')):
@@ -126,6 +156,16 @@ def main():
         e = e[np.abs(e) < 0.2]
         print(f'  {name:24s} median {100 * np.median(e):+.2f} %  mean {100 * np.mean(e):+.2f} %  '
               f'median |error| {100 * np.median(np.abs(e)):.2f} %')
+    if fit_deg is not None:
+        library = np.array(library)
+        library = library[np.all(np.abs(library) < 0.2, axis=1)]
+        moved = np.abs((1 + library[:, 1]) / (1 + library[:, 0]) - 1) > 0.001
+        print(f'  the library\'s lidar source, {len(library)} keypoints ({100 * moved.mean():.0f} % moved by the fit):')
+        for subset, label in ((np.ones(len(library), bool), 'all'), (moved, 'moved')):
+            for column, name in ((0, 'surface mean'), (1, f'plane fit {fit_deg:g} deg')):
+                e = library[subset, column]
+                print(f'    {label:5s} {name:18s} median {100 * np.median(e):+.2f} %  mean {100 * np.mean(e):+.2f} %  '
+                      f'median |error| {100 * np.median(np.abs(e)):.2f} %  rms {100 * np.sqrt(np.mean(e ** 2)):.2f} %')
     counts = np.bincount(np.array(rows))
     print('  LiDAR rows under the kernel: ' + ', '.join(f'{r}: {100 * c / len(rows):.0f} %' for r, c in enumerate(counts) if c))
 

@@ -174,6 +174,23 @@ void bind_depth(py::module_& m) {
       "A registered depth source by spec name[:argument], e.g. 'lidar', 'lidar:ipbasic', 'lidar:cross7', "
       "'stereo', 'precomputed:<folder>'. Raises ConfigError naming a bad spec.");
 
+  m.def(
+      "make_lidar_source",
+      [](const CameraCalibration& calibration, double surface_fit_window_deg, double occlusion_window_deg,
+         float surface_tolerance) {
+        LidarSourceOptions options;
+        options.surface_fit_window_deg = surface_fit_window_deg;
+        options.occlusion_window_deg = occlusion_window_deg;
+        options.surface_tolerance = surface_tolerance;
+        DepthSourceContext context;
+        context.calibration = calibration;
+        return PyDepthSource{make_lidar_source(options, context), py::tuple()};
+      },
+      py::arg("calibration"), py::arg("surface_fit_window_deg") = 0.0, py::arg("occlusion_window_deg") = 0.3,
+      py::arg("surface_tolerance") = 0.05F,
+      "The 'lidar' source (5x5 diamond, surface-mean keypoint depth) with its options: the settings keys "
+      "LiDAR.SurfaceFitWindowDeg, LiDAR.OcclusionWindowDeg and the surface's relative depth step. Raises "
+      "ConfigError naming an option out of range.");
   m.def("read_depth_png", [](const std::filesystem::path& file) { return mat_array(read_depth_png(file)); },
         py::arg("file"), "A depth PNG (uint16, depth x 256) in metres, float32 H x W.");
   m.def(

@@ -117,3 +117,27 @@ def test_depth_png_round_trip(tmp_path):
     depth = np.array([[0.0, 1.5, 10.25]], np.float32)
     rgbl.write_depth_png(tmp_path / "d.png", depth)
     assert np.array_equal(rgbl.read_depth_png(tmp_path / "d.png"), depth)  # multiples of 1/256 survive
+
+
+def test_lidar_source_plane_fit_between_rings():
+    # A road 15 m below a camera looking along it, scanned by four rings: inverse depth is affine in the
+    # row (1/z = (v - cy) / (fy h)), so the plane fit between two rings is exact, while the surface mean
+    # reads the nearer ring alone.
+    camera = rgbl.PinholeCamera(fx=100.0, fy=100.0, cx=50.0, cy=30.0, width=101, height=201)
+    calibration = rgbl.CameraCalibration(camera)
+    points = []
+    for v in (177, 180, 183, 186):
+        z = 1500.0 / (v - 30)
+        points += [[(u - 50) * z / 100.0, 15.0, z, 0.0] for u in range(40, 61)]
+    scan = np.array(points, np.float32)
+    keypoint = np.array([[50.0, 181.4]], np.float32)
+    exact = 1500.0 / (181.4 - 30.0)
+    image = np.zeros((201, 101), np.uint8)
+    mean = rgbl.make_lidar_source(calibration)
+    mean.prepare(image, scan)
+    assert mean.sample(keypoint)[0, 0] == pytest.approx(1500.0 / 153.0, rel=1e-5)  # ring 183's depth
+    fit = rgbl.make_lidar_source(calibration, surface_fit_window_deg=2.5)  # 4 rows either side
+    fit.prepare(image, scan)
+    assert fit.sample(keypoint)[0, 0] == pytest.approx(exact, rel=1e-5)
+    with pytest.raises(rgbl.ConfigError, match="surface_fit_window_deg"):
+        rgbl.make_lidar_source(calibration, surface_fit_window_deg=-1.0)
