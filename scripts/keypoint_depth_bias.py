@@ -109,7 +109,8 @@ def main():
         first = cv2.imread(os.path.join(seq, 'image_0', frames[0]), cv2.IMREAD_GRAYSCALE)
         camera = rgbl.PinholeCamera(P[0, 0], P[1, 1], P[0, 2], P[1, 2], first.shape[1], first.shape[0])
         calibration = rgbl.CameraCalibration(camera, T_cam_lidar=Tr)
-        sources = (rgbl.make_lidar_source(calibration), rgbl.make_lidar_source(calibration, surface_fit_window_deg=fit_deg))
+        sources = (rgbl.make_lidar_source(calibration, surface_fit_window_deg=0.0),
+                   rgbl.make_lidar_source(calibration, surface_fit_window_deg=fit_deg))
     for i in chosen:
         image = cv2.imread(os.path.join(seq, 'image_0', frames[i]), cv2.IMREAD_GRAYSCALE)
         scan = read_scan(os.path.join(seq, 'velodyne', f'{i:06d}.bin'))

@@ -186,7 +186,7 @@ void bind_depth(py::module_& m) {
         context.calibration = calibration;
         return PyDepthSource{make_lidar_source(options, context), py::tuple()};
       },
-      py::arg("calibration"), py::arg("surface_fit_window_deg") = 0.0, py::arg("occlusion_window_deg") = 0.3,
+      py::arg("calibration"), py::arg("surface_fit_window_deg") = LidarSourceOptions{}.surface_fit_window_deg, py::arg("occlusion_window_deg") = 0.3,
       py::arg("surface_tolerance") = 0.05F,
       "The 'lidar' source (5x5 diamond, surface-mean keypoint depth) with its options: the settings keys "
       "LiDAR.SurfaceFitWindowDeg, LiDAR.OcclusionWindowDeg and the surface's relative depth step. Raises "

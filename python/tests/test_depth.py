@@ -133,7 +133,7 @@ def test_lidar_source_plane_fit_between_rings():
     keypoint = np.array([[50.0, 181.4]], np.float32)
     exact = 1500.0 / (181.4 - 30.0)
     image = np.zeros((201, 101), np.uint8)
-    mean = rgbl.make_lidar_source(calibration)
+    mean = rgbl.make_lidar_source(calibration, surface_fit_window_deg=0.0)
     mean.prepare(image, scan)
     assert mean.sample(keypoint)[0, 0] == pytest.approx(1500.0 / 153.0, rel=1e-5)  # ring 183's depth
     fit = rgbl.make_lidar_source(calibration, surface_fit_window_deg=2.5)  # 4 rows either side

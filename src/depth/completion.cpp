@@ -653,7 +653,11 @@ std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius
   if (n < 4 || top > 0.0F || bottom < 0.0F || bottom - top < 2.0F) return std::nullopt;
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(normal);
   if (ldlt.info() != Eigen::Success) return std::nullopt;
-  const double inverse_z = ldlt.solve(rhs)(0);
+  const Eigen::Vector3d plane = ldlt.solve(rhs);  // inverse depth at the keypoint, per column, per row
+  // Only where the rings cross the surface: its inverse depth grows downwards, faster than along the
+  // row (the road, a ramp). On a wall a ring runs along it and its mean already holds.
+  if (!(plane(2) > std::abs(plane(1)))) return std::nullopt;
+  const double inverse_z = plane(0);
   const double z = 1.0 / inverse_z;
   if (!std::isfinite(z) || z <= 0.0 || std::abs(z - surface_z) > 3.0 * surface_tolerance * surface_z) return std::nullopt;
   return static_cast<float>(z);

@@ -81,7 +81,8 @@ KeypointDepth lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions&
 // outside the image get z = 0.
 // fit_rows > 0: z comes instead from a plane fitted, in inverse depth (affine in the pixel on a plane),
 // to the samples of that surface within fit_rows px above and below (and 2 px either side), evaluated
-// at the keypoint, when they bracket its row. A LiDAR's rings sit at fixed elevations from the car, so
+// at the keypoint, when they bracket its row and the plane's inverse depth grows downwards faster than
+// along the row (a surface the rings cross: the road). A LiDAR's rings sit at fixed elevations from the car, so
 // on the road a keypoint between two rings otherwise reads the nearer ring's depth, which moves with
 // the car: between two frames its depth then changes by less than the car moved (docs/accuracy.md,
 // "LiDAR rings move with the car"). The surface grows from the kernel's surface through steps of up to
