@@ -33,11 +33,37 @@ def rotation(axis, deg):
             'z': np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])}[axis]
 
 
-def link_all(src, dst, skip):
+def link_except(src, dst, parts):
+    """dst mirrors src as symlinks except the path parts[0]/parts[1]/...: the folders on it are made
+    real and its last element is left out, for the caller to write."""
     os.makedirs(dst, exist_ok=True)
     for name in os.listdir(src):
-        if name not in skip:
-            os.symlink(os.path.join(src, name), os.path.join(dst, name))
+        if parts and name == parts[0]:
+            if len(parts) > 1:
+                link_except(os.path.join(src, name), os.path.join(dst, name), parts[1:])
+            continue
+        os.symlink(os.path.join(src, name), os.path.join(dst, name))
+
+
+def linked_copy(drive, root, odometry_path, raw_path):
+    """A symlinked copy of the drive under root without one path, given relative to an odometry
+    sequence folder (its poses two levels up) or to a raw drive's day folder (the calibration beside
+    the drive). Returns (the copy to run, the source folder, the copy's folder, the path's parts)."""
+    drive = os.path.abspath(drive)
+    parent = os.path.dirname(drive)
+    if os.path.exists(os.path.join(drive, 'calib.txt')):
+        src, dst, parts = drive, os.path.join(root, 'sequences', os.path.basename(drive)), odometry_path
+        run = dst
+        poses = os.path.join(os.path.dirname(parent), 'poses')
+        if os.path.isdir(poses):
+            os.makedirs(root, exist_ok=True)
+            os.symlink(poses, os.path.join(root, 'poses'))
+    else:
+        src, dst = parent, os.path.join(root, os.path.basename(parent))
+        parts = [p if p != '{drive}' else os.path.basename(drive) for p in raw_path]
+        run = os.path.join(dst, os.path.basename(drive))
+    link_except(src, dst, parts)
+    return run, src, dst, parts
 
 
 def raise_elevation(xyz, deg):
@@ -51,73 +77,39 @@ def raise_elevation(xyz, deg):
 
 def elevated_copy(drive, deg, root):
     """A copy of the drive whose velodyne scans have every point's elevation raised by deg."""
-    drive = os.path.abspath(drive)
-    odometry = os.path.exists(os.path.join(drive, 'calib.txt'))
-    parent = os.path.dirname(drive)
-    if odometry:
-        out = os.path.join(root, 'sequences', os.path.basename(drive))
-        poses = os.path.join(os.path.dirname(parent), 'poses')
-        if os.path.isdir(poses):
-            os.makedirs(root, exist_ok=True)
-            os.symlink(poses, os.path.join(root, 'poses'))
-        scans, scans_out = os.path.join(drive, 'velodyne'), os.path.join(out, 'velodyne')
-        link_all(drive, out, {'velodyne'})
-    else:
-        day = os.path.join(root, os.path.basename(parent))
-        link_all(parent, day, {os.path.basename(drive)})
-        out = os.path.join(day, os.path.basename(drive))
-        link_all(drive, out, {'velodyne_points'})
-        velo = os.path.join(drive, 'velodyne_points')
-        link_all(velo, os.path.join(out, 'velodyne_points'), {'data'})
-        scans, scans_out = os.path.join(velo, 'data'), os.path.join(out, 'velodyne_points', 'data')
+    run, src, dst, parts = linked_copy(drive, root, ['velodyne'], ['{drive}', 'velodyne_points', 'data'])
+    scans, scans_out = os.path.join(src, *parts), os.path.join(dst, *parts)
     os.makedirs(scans_out, exist_ok=True)
     for name in sorted(os.listdir(scans)):
         if not name.endswith('.bin'):
             continue
-        p = np.fromfile(os.path.join(scans, name), dtype=np.float32).reshape(-1, 4)
-        q = p.astype(np.float64)
-        q[:, :3] = raise_elevation(q[:, :3], deg)
-        q.astype(np.float32).tofile(os.path.join(scans_out, name))
-    return out
+        p = np.fromfile(os.path.join(scans, name), dtype=np.float32).reshape(-1, 4).astype(np.float64)
+        p[:, :3] = raise_elevation(p[:, :3], deg)
+        p.astype(np.float32).tofile(os.path.join(scans_out, name))
+    return run
 
 
 def turned_copy(drive, axis, deg, root):
     """A copy of the drive with its LiDAR-to-camera rotation turned; returns the path to run."""
     if axis == 'e':
         return elevated_copy(drive, deg, root)
-    drive = os.path.abspath(drive)
     R = rotation(axis, deg)
-    parent = os.path.dirname(drive)
-    if os.path.exists(os.path.join(drive, 'calib.txt')):  # odometry: Tr in calib.txt, poses two levels up
-        seq = os.path.basename(drive)
-        out = os.path.join(root, 'sequences', seq)
-        link_all(drive, out, {'calib.txt'})
-        poses = os.path.join(os.path.dirname(parent), 'poses')
-        if os.path.isdir(poses):
-            os.symlink(poses, os.path.join(root, 'poses'))
-        lines = []
-        for line in open(os.path.join(drive, 'calib.txt')):
-            if line.startswith('Tr:'):
-                T = np.array([float(v) for v in line.split()[1:]]).reshape(3, 4)
-                T = R @ T
-                line = 'Tr: ' + ' '.join('%.12e' % v for v in T.ravel()) + '\n'
-            lines.append(line)
-        open(os.path.join(out, 'calib.txt'), 'w').writelines(lines)
-        return out
-    # raw: <date>/calib_velo_to_cam.txt beside the drive folder
-    day = os.path.join(root, os.path.basename(parent))
-    link_all(parent, day, {'calib_velo_to_cam.txt'})
+    run, src, dst, parts = linked_copy(drive, root, ['calib.txt'], ['calib_velo_to_cam.txt'])
     lines = []
-    for line in open(os.path.join(parent, 'calib_velo_to_cam.txt')):
-        if line.startswith('R:'):
+    for line in open(os.path.join(src, *parts)):
+        key = line.split(':', 1)[0]
+        if key == 'Tr':  # odometry: T_cam0_velo, 3 x 4
+            T = R @ np.array([float(v) for v in line.split()[1:]]).reshape(3, 4)
+            line = 'Tr: ' + ' '.join('%.12e' % v for v in T.ravel()) + '\n'
+        elif key == 'R':  # raw: rotation and translation on lines of their own
             Rv = R @ np.array([float(v) for v in line.split()[1:]]).reshape(3, 3)
             line = 'R: ' + ' '.join('%.12e' % v for v in Rv.ravel()) + '\n'
-        elif line.startswith('T:'):
+        elif key == 'T':
             t = R @ np.array([float(v) for v in line.split()[1:]])
             line = 'T: ' + ' '.join('%.12e' % v for v in t) + '\n'
         lines.append(line)
-    open(os.path.join(day, 'calib_velo_to_cam.txt'), 'w').writelines(lines)
-    return os.path.join(day, os.path.basename(drive))
+    open(os.path.join(dst, *parts), 'w').writelines(lines)
+    return run
 
 
 def path_ratio(run):

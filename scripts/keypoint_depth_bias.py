@@ -104,16 +104,17 @@ def main():
     orb = cv2.ORB_create(2000)
     errors, rows = [], []
     library = []  # (surface mean, plane fit) relative errors from rgbl's own lidar source
-    if fit_deg is not None:
-        import rgbl  # build/release/python on PYTHONPATH
-        first = cv2.imread(os.path.join(seq, 'image_0', frames[0]), cv2.IMREAD_GRAYSCALE)
-        camera = rgbl.PinholeCamera(P[0, 0], P[1, 1], P[0, 2], P[1, 2], first.shape[1], first.shape[0])
-        calibration = rgbl.CameraCalibration(camera, T_cam_lidar=Tr)
-        sources = (rgbl.make_lidar_source(calibration, surface_fit_window_deg=0.0),
-                   rgbl.make_lidar_source(calibration, surface_fit_window_deg=fit_deg))
+    sources = None
     for i in chosen:
         image = cv2.imread(os.path.join(seq, 'image_0', frames[i]), cv2.IMREAD_GRAYSCALE)
-        scan = read_scan(os.path.join(seq, 'velodyne', f'{i:06d}.bin'))
+        raw = np.fromfile(os.path.join(seq, 'velodyne', f'{i:06d}.bin'), np.float32).reshape(-1, 4)
+        scan = raw[:, :3].astype(np.float64)
+        if fit_deg is not None and sources is None:
+            import rgbl  # build/release/python on PYTHONPATH
+            camera = rgbl.PinholeCamera(P[0, 0], P[1, 1], P[0, 2], P[1, 2], image.shape[1], image.shape[0])
+            calibration = rgbl.CameraCalibration(camera, T_cam_lidar=Tr)
+            sources = (rgbl.make_lidar_source(calibration, surface_fit_window_deg=0.0),
+                       rgbl.make_lidar_source(calibration, surface_fit_window_deg=fit_deg))
         sparse = project((Tr[:3, :3] @ scan.T + Tr[:3, 3:4]).T, P, image.shape)
         if mode == 'real':
             clouds = []
@@ -128,8 +129,7 @@ def main():
             truth_image[truth_image <= 0] = np.inf
         keypoints = orb.detect(image, None)
         lib = None
-        if fit_deg is not None:
-            raw = np.fromfile(os.path.join(seq, 'velodyne', f'{i:06d}.bin'), np.float32).reshape(-1, 4)
+        if sources is not None:
             pixels = np.array([k.pt for k in keypoints], np.float32).reshape(-1, 2)
             lib = []
             for source in sources:

@@ -186,8 +186,10 @@ void bind_depth(py::module_& m) {
         context.calibration = calibration;
         return PyDepthSource{make_lidar_source(options, context), py::tuple()};
       },
-      py::arg("calibration"), py::arg("surface_fit_window_deg") = LidarSourceOptions{}.surface_fit_window_deg, py::arg("occlusion_window_deg") = 0.3,
-      py::arg("surface_tolerance") = 0.05F,
+      // the defaults are the C++ options' own, so the two cannot drift apart
+      py::arg("calibration"), py::arg("surface_fit_window_deg") = LidarSourceOptions{}.surface_fit_window_deg,
+      py::arg("occlusion_window_deg") = LidarSourceOptions{}.occlusion_window_deg,
+      py::arg("surface_tolerance") = LidarSourceOptions{}.surface_tolerance,
       "The 'lidar' source (5x5 diamond, surface-mean keypoint depth) with its options: the settings keys "
       "LiDAR.SurfaceFitWindowDeg, LiDAR.OcclusionWindowDeg and the surface's relative depth step. Raises "
       "ConfigError naming an option out of range.");

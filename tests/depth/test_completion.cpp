@@ -270,24 +270,20 @@ TEST_CASE("surface plane fit: a keypoint between two LiDAR rings on the road get
 
   // Only a surface the rings cross is fitted: one whose inverse depth changes faster along the row
   // than down it (a wall seen at an angle, tilted), or that gets nearer upwards, keeps the mean.
-  for (const auto& [per_column, per_row] : {std::pair{0.002, 0.001}, std::pair{0.0, -0.001}}) {
-    cv::Mat_<float> wall(90, 40, 0.0F);
-    auto z = [&](double u, double v) { return 1.0 / (0.1 + per_column * u + per_row * v); };
+  auto z_at = [](double per_column, double per_row, double u, double v) {
+    return 1.0 / (0.1 + per_column * u + per_row * v);
+  };
+  auto plane_rings = [&](double per_column, double per_row) {  // the plane sampled on rows 50 and 55
+    cv::Mat_<float> sparse(90, 40, 0.0F);
     for (const int v : {50, 55}) {
-      for (int u = 0; u < 40; ++u) wall(v, u) = static_cast<float>(z(u, v));
+      for (int u = 0; u < 40; ++u) sparse(v, u) = static_cast<float>(z_at(per_column, per_row, u, v));
     }
-    INFO("inverse depth per column " << per_column << ", per row " << per_row);
-    CHECK(depth_at(wall, pixel, 3).z == Approx(z(20, 50)).epsilon(1e-6));
-    // the same samples with the row term dominant are fitted
-    if (per_row > 0.0) {
-      cv::Mat_<float> ramp(90, 40, 0.0F);
-      auto zr = [&](double u, double v) { return 1.0 / (0.1 + per_row * u + per_column * v); };
-      for (const int v : {50, 55}) {
-        for (int u = 0; u < 40; ++u) ramp(v, u) = static_cast<float>(zr(u, v));
-      }
-      CHECK(depth_at(ramp, pixel, 3).z == Approx(zr(20, 52)).epsilon(1e-5));
-    }
-  }
+    return sparse;
+  };
+  CHECK(depth_at(plane_rings(0.002, 0.001), pixel, 3).z == Approx(z_at(0.002, 0.001, 20, 50)).epsilon(1e-6));
+  CHECK(depth_at(plane_rings(0.0, -0.001), pixel, 3).z == Approx(z_at(0.0, -0.001, 20, 50)).epsilon(1e-6));
+  // the same samples with the row term dominant (a ramp) are fitted
+  CHECK(depth_at(plane_rings(0.001, 0.002), pixel, 3).z == Approx(z_at(0.001, 0.002, 20, 52)).epsilon(1e-5));
 }
 
 TEST_CASE("samples behind a foreground edge in the camera's view are dropped, a slanted road is kept") {
