@@ -15,7 +15,9 @@ image, or for KITTI the scans of the 10 neighbouring frames moved by the ground-
 median within 1 px). Also prints how many LiDAR rows the kernels hold: the minimum's bias comes from
 the rows the kernel spans. Needs python3-numpy and python3-opencv.
 
-  scripts/keypoint_depth_bias.py MODE SEQ [POSES] --fit DEG
+  scripts/keypoint_depth_bias.py MODE SEQ [POSES] --fit DEG [--frames FIRST LAST]
+
+--frames grades only those frames (the simulator: every frame between them; KITTI: every 4th of 5-45).
 
 With the Python module on PYTHONPATH (build/release/python), --fit also grades the library's own
 `lidar` source (rgbl.make_lidar_source: the surface mean after the occlusion filter) against the same
@@ -90,6 +92,11 @@ def main():
         i = sys.argv.index('--fit')
         fit_deg = float(sys.argv[i + 1])
         del sys.argv[i:i + 2]
+    first_last = None
+    if '--frames' in sys.argv:
+        i = sys.argv.index('--frames')
+        first_last = (int(sys.argv[i + 1]), int(sys.argv[i + 2]))
+        del sys.argv[i:i + 3]
     if len(sys.argv) < 3 or sys.argv[1] not in ('real', 'sim'):
         sys.exit(__doc__)
     mode, seq = sys.argv[1], sys.argv[2]
@@ -101,6 +108,9 @@ def main():
         chosen = range(5, min(len(frames) - 5, 46), 4)
     else:
         chosen = range(0, min(len(frames), 8))
+    if first_last is not None:
+        chosen = [i for i in chosen if first_last[0] <= i <= first_last[1]] if mode == 'real' else \
+            range(first_last[0], min(len(frames), first_last[1] + 1))
     orb = cv2.ORB_create(2000)
     errors, rows = [], []
     library = []  # (surface mean, plane fit) relative errors from rgbl's own lidar source
