@@ -12,7 +12,6 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
-#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -591,10 +590,12 @@ struct SurfaceScratch {
   std::vector<SurfaceSample> tall;  // the plane fit's taller window
 };
 
-// The plane through the surface's samples in a window fit_rows px tall, in inverse depth, at the
+// The plane through the surface's samples in a window fit.rows px tall, in inverse depth, at the
 // keypoint (lookup_surface_depth); nullopt when they do not bracket the keypoint's row or are too few.
-std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius, float surface_tolerance, int fit_rows,
-                                       const Eigen::Vector2f& pixel, float surface_z, SurfaceScratch& scratch) {
+std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius, float surface_tolerance,
+                                       const SurfacePlaneFit& fit, const Eigen::Vector2f& pixel, float surface_z,
+                                       SurfaceScratch& scratch) {
+  const int fit_rows = fit.rows;
   const int cx = static_cast<int>(std::floor(pixel.x() + 0.5F)), cy = static_cast<int>(std::floor(pixel.y() + 0.5F));
   auto& tall = scratch.tall;
   tall.clear();
@@ -654,9 +655,24 @@ std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(normal);
   if (ldlt.info() != Eigen::Success) return std::nullopt;
   const Eigen::Vector3d plane = ldlt.solve(rhs);  // inverse depth at the keypoint, per column, per row
-  // Only where the rings cross the surface: its inverse depth grows downwards, faster than along the
-  // row (the road, a ramp). On a wall a ring runs along it and its mean already holds.
-  if (!(plane(2) > std::abs(plane(1)))) return std::nullopt;
+  // Only on a surface below the camera and about level (SurfacePlaneFit): the road and ramps, which the
+  // rings cross. The plane's normal in the camera's frame, from its inverse depth per pixel.
+  const Eigen::Vector3d surface_normal(plane(1) * fit.fx, plane(2) * fit.fy,
+                                            plane(0) - plane(1) * (pixel.x() - fit.cx) - plane(2) * (pixel.y() - fit.cy));
+  if (!(surface_normal.y() > std::cos(fit.max_tilt_deg * std::numbers::pi / 180.0) * surface_normal.norm())) return std::nullopt;
+  // And only if the samples lie on that plane within what their rounding to pixel centres (uniform,
+  // 1/12 px^2 per axis) and the range noise explain, at 3 sigma: a depth step the surface grew across
+  // (far away the growth allows 10-15 % between rows 4-6 px apart) can look level, but is not a plane.
+  double squares = 0.0;
+  for (const SurfaceSample& s : tall) {
+    if (!s.on_surface) continue;
+    const double ex = static_cast<double>(cx + s.cell.dx) - pixel.x(), ey = static_cast<double>(cy + s.cell.dy) - pixel.y();
+    const double r = 1.0 / static_cast<double>(s.d) - (plane(0) + plane(1) * ex + plane(2) * ey);
+    squares += r * r;
+  }
+  const double noise = fit.range_sigma * plane(0) * plane(0);  // in inverse depth
+  const double expected = (plane(1) * plane(1) + plane(2) * plane(2)) / 12.0 + noise * noise;
+  if (squares / static_cast<double>(n - 3) > 9.0 * expected) return std::nullopt;
   const double inverse_z = plane(0);
   const double z = 1.0 / inverse_z;
   if (!std::isfinite(z) || z <= 0.0 || std::abs(z - surface_z) > 3.0 * surface_tolerance * surface_z) return std::nullopt;
@@ -664,7 +680,8 @@ std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius
 }
 
 KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const Cell> cells, int radius,
-                                 const Inversion& inv, float surface_tolerance, int fit_rows, const Eigen::Vector2f& pixel,
+                                 const Inversion& inv, float surface_tolerance, const SurfacePlaneFit& fit,
+                                 const Eigen::Vector2f& pixel,
                                  SurfaceScratch& scratch) {
   KeypointDepth result;
   const KernelWindow window(sparse, radius, pixel);
@@ -711,8 +728,8 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
     inverse_depths += w / s.d;
   }
   result.z = static_cast<float>(weights / inverse_depths);
-  if (fit_rows > 0) {
-    if (const auto z = fit_surface_plane(sparse, radius, surface_tolerance, fit_rows, pixel, result.z, scratch)) {
+  if (fit.rows > 0) {
+    if (const auto z = fit_surface_plane(sparse, radius, surface_tolerance, fit, pixel, result.z, scratch)) {
       result.z = *z;
     }
   }
@@ -723,11 +740,19 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
 
 }  // namespace
 
+void SurfacePlaneFit::validate() const {
+  require(rows >= 0, "lidar surface fit rows", ">= 0 px (0 = off)");
+  require(fx > 0.0 && fy > 0.0, "lidar surface fit focal lengths", "> 0 px (the camera's fx, fy)");
+  require(max_tilt_deg > 0.0 && max_tilt_deg < 90.0, "lidar.surface_fit_max_tilt_deg", "0 .. 90 deg");
+  require(range_sigma > 0.0, "lidar.range_sigma", "> 0 m");
+}
+
 void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, float surface_tolerance,
-                          std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out, int fit_rows) {
+                          std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out,
+                          const SurfacePlaneFit& fit) {
   options.validate();
   require(surface_tolerance >= 0.0F && surface_tolerance < 1.0F, "lidar.surface_tolerance", "a fraction in [0, 1)");
-  require(fit_rows >= 0, "lidar surface fit rows", ">= 0 px (0 = off)");
+  fit.validate();
   CV_Assert(out.size() == pixels.size());
   const Kernel kernel = options.kernel();
   const std::vector<Cell> cells = kernel_cells(kernel);
@@ -736,7 +761,7 @@ void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& 
   scratch.samples.reserve(cells.size());
   scratch.frontier.reserve(cells.size());
   for (std::size_t i = 0; i < pixels.size(); ++i) {
-    out[i] = lookup_surface_one(sparse, cells, kernel.radius(), inv, surface_tolerance, fit_rows, pixels[i], scratch);
+    out[i] = lookup_surface_one(sparse, cells, kernel.radius(), inv, surface_tolerance, fit, pixels[i], scratch);
   }
 }
 

@@ -32,6 +32,9 @@ void LidarSourceOptions::validate() const {
   require(occlusion_window_deg >= 0.0 && occlusion_window_deg < 5.0, "lidar.occlusion_window_deg", "0 (off) .. 5 deg");
   require(occlusion_ratio > 1.0F, "lidar.occlusion_ratio", "> 1");
   require(surface_fit_window_deg >= 0.0 && surface_fit_window_deg < 5.0, "lidar.surface_fit_window_deg", "0 (off) .. 5 deg");
+  require(surface_fit_max_tilt_deg > 0.0 && surface_fit_max_tilt_deg < 90.0, "lidar.surface_fit_max_tilt_deg",
+          "0 .. 90 deg");
+  require(range_sigma > 0.0, "lidar.range_sigma", "> 0 m");
 }
 
 void PrecomputedSourceOptions::validate() const {
@@ -127,7 +130,9 @@ class LidarDepthSource final : public DepthSource {
         options_(options) {
     options_.validate();
     occlusion_radius_ = occlusion_radius_px(camera_.fx, options_.occlusion_window_deg);  // 0: off
-    surface_fit_rows_ = occlusion_radius_px(camera_.fy, options_.surface_fit_window_deg);  // 0: off
+    surface_fit_ = {occlusion_radius_px(camera_.fy, options_.surface_fit_window_deg),  // 0: off
+                    camera_.fx, camera_.fy, camera_.cx, camera_.cy, options_.surface_fit_max_tilt_deg,
+                    options_.range_sigma};
   }
 
   std::string_view name() const override { return "lidar"; }
@@ -153,7 +158,7 @@ class LidarDepthSource final : public DepthSource {
   void sample(std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) const override {
     if (options_.completion == CompletionMethod::dilation) {
       if (options_.keypoint_depth == KeypointDepthRule::surface_mean) {
-        lookup_surface_depth(sparse_, options_.dilation, options_.surface_tolerance, pixels, out, surface_fit_rows_);
+        lookup_surface_depth(sparse_, options_.dilation, options_.surface_tolerance, pixels, out, surface_fit_);
       } else {
         lookup_depth(sparse_, options_.dilation, pixels, out);
       }
@@ -187,7 +192,7 @@ class LidarDepthSource final : public DepthSource {
   LidarSourceOptions options_;
   cv::Mat_<float> sparse_;
   int occlusion_radius_ = 0;  // px, from occlusion_window_deg once
-  int surface_fit_rows_ = 0;  // px, from surface_fit_window_deg once
+  SurfacePlaneFit surface_fit_;  // from surface_fit_window_deg and the camera, once
   cv::Mat_<float> occlusion_scratch_;
   cv::Mat_<float> dense_;  // only for the dense completion methods
 };

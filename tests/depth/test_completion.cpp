@@ -12,8 +12,10 @@
 
 #include <cstring>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <tuple>
+#include <utility>
 
 namespace {
 
@@ -245,10 +247,11 @@ TEST_CASE("surface plane fit: a keypoint between two LiDAR rings on the road get
     for (int u = 0; u < 40; ++u) rings(v, u) = static_cast<float>(f * h / v);
   }
   const Eigen::Vector2f pixel(20.0F, 52.0F);
+  // the camera: fx = fy = 350, the principal point at column 20 on the horizon (row 0)
   auto depth_at = [&](const cv::Mat_<float>& sparse, const Eigen::Vector2f& p, int fit_rows) {
     rgbl::KeypointDepth out;
     rgbl::lookup_surface_depth(sparse, {}, 0.05F, std::span<const Eigen::Vector2f>(&p, 1),
-                               std::span<rgbl::KeypointDepth>(&out, 1), fit_rows);
+                               std::span<rgbl::KeypointDepth>(&out, 1), {fit_rows, f, f, 20.0, 0.0, 20.0});
     return out;
   };
   // without the fit: the ring's depth, 4 % beyond the road under the keypoint
@@ -268,22 +271,64 @@ TEST_CASE("surface plane fit: a keypoint between two LiDAR rings on the road get
   CHECK(depth_at(step, pixel, 3).z == Approx(f * h / 50.0).epsilon(1e-6));
   CHECK_THROWS_AS(depth_at(rings, pixel, -1), rgbl::ConfigError);
 
-  // Only a surface the rings cross is fitted: one whose inverse depth changes faster along the row
-  // than down it (a wall seen at an angle, tilted), or that gets nearer upwards, keeps the mean.
-  auto z_at = [](double per_column, double per_row, double u, double v) {
-    return 1.0 / (0.1 + per_column * u + per_row * v);
-  };
-  auto plane_rings = [&](double per_column, double per_row) {  // the plane sampled on rows 50 and 55
+  rgbl::KeypointDepth out;
+  CHECK_THROWS_AS(rgbl::lookup_surface_depth(rings, {}, 0.05F, std::span<const Eigen::Vector2f>(&pixel, 1),
+                                             std::span<rgbl::KeypointDepth>(&out, 1), {3, f, f, 20.0, 0.0, 90.0}),
+                  rgbl::ConfigError);
+
+  // Only a surface about level below the camera is fitted (within 20 deg here). A plane n . X = d in
+  // the camera's frame (y down) has 1/z = (n_x (u - 20) / f + n_y v / f + n_z) / d.
+  auto plane_rings = [&](const Eigen::Vector3d& n, double d) {  // sampled on rows 50 and 55
     cv::Mat_<float> sparse(90, 40, 0.0F);
     for (const int v : {50, 55}) {
-      for (int u = 0; u < 40; ++u) sparse(v, u) = static_cast<float>(z_at(per_column, per_row, u, v));
+      for (int u = 0; u < 40; ++u) sparse(v, u) = static_cast<float>(d / n.dot(Eigen::Vector3d((u - 20) / f, v / f, 1.0)));
     }
     return sparse;
   };
-  CHECK(depth_at(plane_rings(0.002, 0.001), pixel, 3).z == Approx(z_at(0.002, 0.001, 20, 50)).epsilon(1e-6));
-  CHECK(depth_at(plane_rings(0.0, -0.001), pixel, 3).z == Approx(z_at(0.0, -0.001, 20, 50)).epsilon(1e-6));
-  // the same samples with the row term dominant (a ramp) are fitted
-  CHECK(depth_at(plane_rings(0.001, 0.002), pixel, 3).z == Approx(z_at(0.001, 0.002, 20, 52)).epsilon(1e-5));
+  auto z_on = [&](const Eigen::Vector3d& n, double d, double v) { return d / n.dot(Eigen::Vector3d(0.0, v / f, 1.0)); };
+  const double deg = std::numbers::pi / 180.0;
+  // a road falling 10 deg ahead and one sloping 15 deg sideways: fitted exactly
+  for (const Eigen::Vector3d n : {Eigen::Vector3d(0.0, std::cos(10 * deg), std::sin(10 * deg)),
+                                  Eigen::Vector3d(std::sin(15 * deg), std::cos(15 * deg), 0.0)}) {
+    CAPTURE(n.transpose());
+    CHECK(depth_at(plane_rings(n, h), pixel, 3).z == Approx(z_on(n, h, 52)).epsilon(1e-5));
+  }
+  // keeping the ring's depth: a slope falling 30 deg, a wall leaning back 30 deg, a wall at 45 deg to
+  // the view
+  for (const auto& [n, d] : {std::pair{Eigen::Vector3d(0.0, std::cos(30 * deg), std::sin(30 * deg)), h},
+                             std::pair{Eigen::Vector3d(0.0, -std::sin(30 * deg), -std::cos(30 * deg)), -12.0},
+                             std::pair{Eigen::Vector3d(std::sqrt(0.5), 0.0, std::sqrt(0.5)), 10.0}}) {
+    CAPTURE(n.transpose(), d);
+    const cv::Mat_<float> sparse = plane_rings(n, d);
+    REQUIRE(sparse(50, 20) > 0.0F);
+    REQUIRE(sparse(55, 20) > 0.0F);
+    CHECK(depth_at(sparse, pixel, 3).z == Approx(z_on(n, d, 50)).epsilon(1e-6));
+  }
+
+  // Nor across a depth step: a keypoint at row 50 on an object 50 m away (rows 51 and 53) with another
+  // at 54 m above it (rows 47 and 49). 8 % is too much for rows 2 apart, but the fit's growth allows
+  // 10 % between rows 4 apart (53 to 49), so the window holds both; fitted, their plane would say
+  // 51.9 m. Their scatter about it is far beyond pixel rounding and 2 cm of range noise, so the object
+  // keeps its 50 m, even with the tilt test all but off (89 deg).
+  cv::Mat_<float> step_up(90, 40, 0.0F);
+  for (int u = 0; u < 40; ++u) {
+    for (const int v : {47, 49}) step_up(v, u) = 54.0F;
+    for (const int v : {51, 53}) step_up(v, u) = 50.0F;
+  }
+  const Eigen::Vector2f at_50(20.0F, 50.0F);
+  rgbl::KeypointDepth on_step;
+  rgbl::lookup_surface_depth(step_up, {}, 0.05F, std::span<const Eigen::Vector2f>(&at_50, 1),
+                             std::span<rgbl::KeypointDepth>(&on_step, 1), {3, f, f, 20.0, 0.0, 89.0});
+  CHECK(on_step.z == Approx(50.0));
+  // the same rows on one plane (inverse depth affine in the row) are fitted
+  cv::Mat_<float> ramp(90, 40, 0.0F);
+  for (int u = 0; u < 40; ++u) {
+    for (const int v : {47, 49, 51, 53}) ramp(v, u) = static_cast<float>(1.0 / (1.0 / 50.0 + (v - 51) * 1e-4));
+  }
+  rgbl::KeypointDepth on_ramp;
+  rgbl::lookup_surface_depth(ramp, {}, 0.05F, std::span<const Eigen::Vector2f>(&at_50, 1),
+                             std::span<rgbl::KeypointDepth>(&on_ramp, 1), {3, f, f, 20.0, 0.0, 89.0});
+  CHECK(on_ramp.z == Approx(1.0 / (1.0 / 50.0 - 1e-4)).epsilon(1e-5));
 }
 
 TEST_CASE("samples behind a foreground edge in the camera's view are dropped, a slanted road is kept") {

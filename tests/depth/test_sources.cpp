@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -146,9 +147,12 @@ TEST_CASE("lidar source on real frames: keypoint samples equal the dense map (di
   std::vector<Eigen::Vector2f> pixels;
   for (int y = 0; y < height; y += 3)
     for (int x = 0; x < width; x += 2) pixels.emplace_back(static_cast<float>(x) + 0.3F, static_cast<float>(y) - 0.4F);
-  auto sample = [&](rgbl::KeypointDepthRule rule, cv::Mat_<float>& dense) {
-    auto source = rgbl::builtin_depth_sources().create(
-        rule == rgbl::KeypointDepthRule::dilated ? "lidar:dilated" : "lidar", settings);
+  // the rules as such: the surface mean without the ring plane fit (on by default, checked below)
+  auto sample = [&](rgbl::KeypointDepthRule rule, cv::Mat_<float>& dense, double fit_deg = 0.0) {
+    rgbl::LidarSourceOptions options;
+    options.keypoint_depth = rule;
+    options.surface_fit_window_deg = fit_deg;
+    auto source = rgbl::make_lidar_source(options, settings);
     source->prepare(frame);
     dense = source->dense_depth();
     std::vector<rgbl::KeypointDepth> out(pixels.size());
@@ -182,6 +186,20 @@ TEST_CASE("lidar source on real frames: keypoint samples equal the dense map (di
   CHECK(off_surface == 0);
   CHECK(changed > 0);
   CHECK(with_depth > pixels.size() / 5);
+
+  // The ring plane fit (LiDAR.SurfaceFitWindowDeg 0.5) moves only some keypoints (those on the road
+  // between rings), never by more than its guard, 3 x the surface tolerance, from the surface mean.
+  cv::Mat_<float> dense_fit;
+  const auto fitted = sample(rgbl::KeypointDepthRule::surface_mean, dense_fit, 0.5);
+  std::size_t moved = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    CHECK((fitted[i].z > 0.0F) == (surface[i].z > 0.0F));
+    if (!(surface[i].z > 0.0F)) continue;
+    CHECK(std::abs(fitted[i].z - surface[i].z) <= 3.0F * 0.05F * surface[i].z * 1.0001F);
+    moved += std::abs(fitted[i].z - surface[i].z) > 1e-3F * surface[i].z ? 1U : 0U;
+  }
+  CHECK(moved > 0);
+  CHECK(moved < with_depth / 2);
 }
 
 TEST_CASE("depth PNGs: depth x 256 rounded, 0 for no depth and for depths that do not fit") {

@@ -70,6 +70,23 @@ void lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions& options,
                   std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out);
 KeypointDepth lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, const Eigen::Vector2f& pixel);
 
+// The ring plane fit of lookup_surface_depth. A plane through the samples, 1/z = a + b du + c dv at
+// pixel offsets (du, dv) from the keypoint (u, v), has in the camera's frame the normal
+// (b fx, c fy, a - b (u - cx) - c (v - cy)); it is fitted only where that normal lies within
+// max_tilt_deg of the camera's down axis (+y): a surface below the camera, level or sloping like a road.
+// On a wall a ring runs along the surface and the mean already holds. Nor is it fitted where the
+// samples scatter about the plane by more than pixel rounding and range_sigma explain (3 sigma): far
+// away a depth step between two objects, which the surface's growth can cross, looks level.
+struct SurfacePlaneFit {
+  int rows = 0;  // px above and below the keypoint; 0 = off
+  double fx = 1.0, fy = 1.0, cx = 0.0, cy = 0.0;  // the camera's intrinsics, px
+  double max_tilt_deg = 20.0;
+  // The samples must lie on the plane within their rounding to pixel centres and this range noise, m.
+  double range_sigma = 0.02;
+
+  void validate() const;
+};
+
 // The dilation's keypoint depth without its bias towards the camera. The same kernel and the same
 // foreground rule (the nearest surface under the kernel wins), but z is the inverse-distance-weighted
 // mean, in inverse depth, of the samples on that surface instead of the nearest depth itself: on every
@@ -79,16 +96,17 @@ KeypointDepth lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions&
 // joins row by row and a background behind an edge stays out. Weights are 1 / max(distance, 0.5 px).
 // sample_distance_px is the nearest surface sample's distance; spread is as for lookup_depth. Pixels
 // outside the image get z = 0.
-// fit_rows > 0: z comes instead from a plane fitted, in inverse depth (affine in the pixel on a plane),
-// to the samples of that surface within fit_rows px above and below (and 2 px either side), evaluated
-// at the keypoint, when they bracket its row and the plane's inverse depth grows downwards faster than
-// along the row (a surface the rings cross: the road). A LiDAR's rings sit at fixed elevations from the car, so
+// fit.rows > 0: z comes instead from a plane fitted, in inverse depth (affine in the pixel on a plane),
+// to the samples of that surface within fit.rows px above and below (and 2 px either side), evaluated
+// at the keypoint, when they bracket its row and the plane is level within fit.max_tilt_deg in the
+// camera's frame (the road, a ramp; see SurfacePlaneFit). A LiDAR's rings sit at fixed elevations from the car, so
 // on the road a keypoint between two rings otherwise reads the nearer ring's depth, which moves with
 // the car: between two frames its depth then changes by less than the car moved (docs/accuracy.md,
 // "LiDAR rings move with the car"). The surface grows from the kernel's surface through steps of up to
 // surface_tolerance per 2 rows; the fit is kept only within 3 x surface_tolerance of the mean.
 void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, float surface_tolerance,
-                          std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out, int fit_rows = 0);
+                          std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out,
+                          const SurfacePlaneFit& fit = {});
 
 // Drops the samples of `sparse` that the camera cannot see: a sample with a sample nearer by more than
 // the factor `ratio` within `radius` px (a square) lies behind a foreground edge in the camera's view.
