@@ -288,7 +288,7 @@ TEST_CASE("surface plane fit: a keypoint between two LiDAR rings on the road get
   auto z_on = [&](const Eigen::Vector3d& n, double d, double v) { return d / n.dot(Eigen::Vector3d(0.0, v / f, 1.0)); };
   const double deg = std::numbers::pi / 180.0;
   // a road falling 10 deg ahead and one sloping 15 deg sideways: fitted exactly
-  for (const Eigen::Vector3d n : {Eigen::Vector3d(0.0, std::cos(10 * deg), std::sin(10 * deg)),
+  for (const Eigen::Vector3d& n : {Eigen::Vector3d(0.0, std::cos(10 * deg), std::sin(10 * deg)),
                                   Eigen::Vector3d(std::sin(15 * deg), std::cos(15 * deg), 0.0)}) {
     CAPTURE(n.transpose());
     CHECK(depth_at(plane_rings(n, h), pixel, 3).z == Approx(z_on(n, h, 52)).epsilon(1e-5));
