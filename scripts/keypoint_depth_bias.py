@@ -15,7 +15,7 @@ image, or for KITTI the scans of the 10 neighbouring frames moved by the ground-
 median within 1 px). Also prints how many LiDAR rows the kernels hold: the minimum's bias comes from
 the rows the kernel spans. Needs python3-numpy and python3-opencv.
 
-  scripts/keypoint_depth_bias.py MODE SEQ [POSES] --fit DEG [--frames FIRST LAST]
+  scripts/keypoint_depth_bias.py MODE SEQ [POSES] [--fit DEG] [--frames FIRST LAST]
 
 --frames grades only those frames (the simulator: every frame between them; KITTI: every 4th of 5-45).
 
@@ -86,17 +86,19 @@ def keypoint_depths(sparse, px, py):
     return a[:, 2].min(), np.sum(w) / np.sum(w / s[:, 2]), a[:, 2].max() - a[:, 2].min(), len(set(a[:, 1]))
 
 
+def take_option(name, count, cast):
+    """the values after `name` in argv (one value, or a tuple of `count`), removed from it; None without it"""
+    if name not in sys.argv:
+        return None
+    i = sys.argv.index(name)
+    values = tuple(cast(v) for v in sys.argv[i + 1:i + 1 + count])
+    del sys.argv[i:i + 1 + count]
+    return values[0] if count == 1 else values
+
+
 def main():
-    fit_deg = None
-    if '--fit' in sys.argv:
-        i = sys.argv.index('--fit')
-        fit_deg = float(sys.argv[i + 1])
-        del sys.argv[i:i + 2]
-    first_last = None
-    if '--frames' in sys.argv:
-        i = sys.argv.index('--frames')
-        first_last = (int(sys.argv[i + 1]), int(sys.argv[i + 2]))
-        del sys.argv[i:i + 3]
+    fit_deg = take_option('--fit', 1, float)
+    first_last = take_option('--frames', 2, int)
     if len(sys.argv) < 3 or sys.argv[1] not in ('real', 'sim'):
         sys.exit(__doc__)
     mode, seq = sys.argv[1], sys.argv[2]
@@ -109,8 +111,11 @@ def main():
     else:
         chosen = range(0, min(len(frames), 8))
     if first_last is not None:
-        chosen = [i for i in chosen if first_last[0] <= i <= first_last[1]] if mode == 'real' else \
-            range(first_last[0], min(len(frames), first_last[1] + 1))
+        first, last = first_last
+        if mode == 'real':
+            chosen = [i for i in chosen if first <= i <= last]
+        else:
+            chosen = range(first, min(len(frames), last + 1))
     orb = cv2.ORB_create(2000)
     errors, rows = [], []
     library = []  # (surface mean, plane fit) relative errors from rgbl's own lidar source

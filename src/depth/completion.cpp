@@ -592,15 +592,15 @@ struct SurfaceScratch {
 
 // The plane through the surface's samples in a window fit.rows px tall, in inverse depth, at the
 // keypoint (lookup_surface_depth); nullopt when they do not bracket the keypoint's row or are too few.
+// min_cos_tilt: cos(fit.max_tilt_deg), once per call of lookup_surface_depth.
 std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius, float surface_tolerance,
-                                       const SurfacePlaneFit& fit, const Eigen::Vector2f& pixel, float surface_z,
-                                       SurfaceScratch& scratch) {
-  const int fit_rows = fit.rows;
+                                       const SurfacePlaneFit& fit, double min_cos_tilt, const Eigen::Vector2f& pixel,
+                                       float surface_z, SurfaceScratch& scratch) {
   const int cx = static_cast<int>(std::floor(pixel.x() + 0.5F)), cy = static_cast<int>(std::floor(pixel.y() + 0.5F));
   auto& tall = scratch.tall;
   tall.clear();
   constexpr int kHalfWidth = 2;
-  for (int dy = -fit_rows; dy <= fit_rows; ++dy) {
+  for (int dy = -fit.rows; dy <= fit.rows; ++dy) {
     if (cy + dy < 0 || cy + dy >= sparse.rows) continue;
     const float* row = sparse[cy + dy];
     for (int dx = -kHalfWidth; dx <= kHalfWidth; ++dx) {
@@ -638,14 +638,17 @@ std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius
   }
   Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
   Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+  double y_squares = 0.0;  // for the residual: sum r^2 = sum y^2 - plane . rhs at the least-squares plane
   float top = std::numeric_limits<float>::max(), bottom = std::numeric_limits<float>::lowest();
   int n = 0;
   for (const SurfaceSample& s : tall) {
     if (!s.on_surface) continue;
     const double ex = static_cast<double>(cx + s.cell.dx) - pixel.x(), ey = static_cast<double>(cy + s.cell.dy) - pixel.y();
     const Eigen::Vector3d j(1.0, ex, ey);
+    const double y = 1.0 / static_cast<double>(s.d);
     normal += j * j.transpose();
-    rhs += j / static_cast<double>(s.d);
+    rhs += j * y;
+    y_squares += y * y;
     top = std::min(top, static_cast<float>(ey));
     bottom = std::max(bottom, static_cast<float>(ey));
     ++n;
@@ -657,19 +660,14 @@ std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius
   const Eigen::Vector3d plane = ldlt.solve(rhs);  // inverse depth at the keypoint, per column, per row
   // Only on a surface below the camera and about level (SurfacePlaneFit): the road and ramps, which the
   // rings cross. The plane's normal in the camera's frame, from its inverse depth per pixel.
-  const Eigen::Vector3d surface_normal(plane(1) * fit.fx, plane(2) * fit.fy,
-                                            plane(0) - plane(1) * (pixel.x() - fit.cx) - plane(2) * (pixel.y() - fit.cy));
-  if (!(surface_normal.y() > std::cos(fit.max_tilt_deg * std::numbers::pi / 180.0) * surface_normal.norm())) return std::nullopt;
+  const PinholeCamera& camera = fit.camera;
+  const Eigen::Vector3d surface_normal(plane(1) * camera.fx, plane(2) * camera.fy,
+                                       plane(0) - plane(1) * (pixel.x() - camera.cx) - plane(2) * (pixel.y() - camera.cy));
+  if (!(surface_normal.y() > min_cos_tilt * surface_normal.norm())) return std::nullopt;
   // And only if the samples lie on that plane within what their rounding to pixel centres (uniform,
   // 1/12 px^2 per axis) and the range noise explain, at 3 sigma: a depth step the surface grew across
   // (far away the growth allows 10-15 % between rows 4-6 px apart) can look level, but is not a plane.
-  double squares = 0.0;
-  for (const SurfaceSample& s : tall) {
-    if (!s.on_surface) continue;
-    const double ex = static_cast<double>(cx + s.cell.dx) - pixel.x(), ey = static_cast<double>(cy + s.cell.dy) - pixel.y();
-    const double r = 1.0 / static_cast<double>(s.d) - (plane(0) + plane(1) * ex + plane(2) * ey);
-    squares += r * r;
-  }
+  const double squares = std::max(0.0, y_squares - plane.dot(rhs));
   const double noise = fit.range_sigma * plane(0) * plane(0);  // in inverse depth
   const double expected = (plane(1) * plane(1) + plane(2) * plane(2)) / 12.0 + noise * noise;
   if (squares / static_cast<double>(n - 3) > 9.0 * expected) return std::nullopt;
@@ -681,8 +679,7 @@ std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius
 
 KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const Cell> cells, int radius,
                                  const Inversion& inv, float surface_tolerance, const SurfacePlaneFit& fit,
-                                 const Eigen::Vector2f& pixel,
-                                 SurfaceScratch& scratch) {
+                                 double min_cos_tilt, const Eigen::Vector2f& pixel, SurfaceScratch& scratch) {
   KeypointDepth result;
   const KernelWindow window(sparse, radius, pixel);
   if (window.empty()) return result;
@@ -729,7 +726,7 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
   }
   result.z = static_cast<float>(weights / inverse_depths);
   if (fit.rows > 0) {
-    if (const auto z = fit_surface_plane(sparse, radius, surface_tolerance, fit, pixel, result.z, scratch)) {
+    if (const auto z = fit_surface_plane(sparse, radius, surface_tolerance, fit, min_cos_tilt, pixel, result.z, scratch)) {
       result.z = *z;
     }
   }
@@ -742,7 +739,7 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
 
 void SurfacePlaneFit::validate() const {
   require(rows >= 0, "lidar surface fit rows", ">= 0 px (0 = off)");
-  require(fx > 0.0 && fy > 0.0, "lidar surface fit focal lengths", "> 0 px (the camera's fx, fy)");
+  if (rows > 0) camera.validate();
   require(max_tilt_deg > 0.0 && max_tilt_deg < 90.0, "lidar.surface_fit_max_tilt_deg", "0 .. 90 deg");
   require(range_sigma > 0.0, "lidar.range_sigma", "> 0 m");
 }
@@ -757,11 +754,13 @@ void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& 
   const Kernel kernel = options.kernel();
   const std::vector<Cell> cells = kernel_cells(kernel);
   const Inversion inv(options.max_depth);
+  const double min_cos_tilt = std::cos(fit.max_tilt_deg * std::numbers::pi / 180.0);
   SurfaceScratch scratch;
   scratch.samples.reserve(cells.size());
   scratch.frontier.reserve(cells.size());
   for (std::size_t i = 0; i < pixels.size(); ++i) {
-    out[i] = lookup_surface_one(sparse, cells, kernel.radius(), inv, surface_tolerance, fit, pixels[i], scratch);
+    out[i] = lookup_surface_one(sparse, cells, kernel.radius(), inv, surface_tolerance, fit, min_cos_tilt, pixels[i],
+                                scratch);
   }
 }
 

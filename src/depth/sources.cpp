@@ -32,9 +32,10 @@ void LidarSourceOptions::validate() const {
   require(occlusion_window_deg >= 0.0 && occlusion_window_deg < 5.0, "lidar.occlusion_window_deg", "0 (off) .. 5 deg");
   require(occlusion_ratio > 1.0F, "lidar.occlusion_ratio", "> 1");
   require(surface_fit_window_deg >= 0.0 && surface_fit_window_deg < 5.0, "lidar.surface_fit_window_deg", "0 (off) .. 5 deg");
-  require(surface_fit_max_tilt_deg > 0.0 && surface_fit_max_tilt_deg < 90.0, "lidar.surface_fit_max_tilt_deg",
-          "0 .. 90 deg");
-  require(range_sigma > 0.0, "lidar.range_sigma", "> 0 m");
+  SurfacePlaneFit fit;  // its checks of the two options, not a copy of them
+  fit.max_tilt_deg = surface_fit_max_tilt_deg;
+  fit.range_sigma = range_sigma;
+  fit.validate();
 }
 
 void PrecomputedSourceOptions::validate() const {
@@ -131,8 +132,7 @@ class LidarDepthSource final : public DepthSource {
     options_.validate();
     occlusion_radius_ = occlusion_radius_px(camera_.fx, options_.occlusion_window_deg);  // 0: off
     surface_fit_ = {occlusion_radius_px(camera_.fy, options_.surface_fit_window_deg),  // 0: off
-                    camera_.fx, camera_.fy, camera_.cx, camera_.cy, options_.surface_fit_max_tilt_deg,
-                    options_.range_sigma};
+                    camera_, options_.surface_fit_max_tilt_deg, options_.range_sigma};
   }
 
   std::string_view name() const override { return "lidar"; }

@@ -248,10 +248,15 @@ TEST_CASE("surface plane fit: a keypoint between two LiDAR rings on the road get
   }
   const Eigen::Vector2f pixel(20.0F, 52.0F);
   // the camera: fx = fy = 350, the principal point at column 20 on the horizon (row 0)
-  auto depth_at = [&](const cv::Mat_<float>& sparse, const Eigen::Vector2f& p, int fit_rows) {
+  rgbl::PinholeCamera camera;
+  camera.fx = camera.fy = f;
+  camera.cx = 20.0;
+  camera.width = 40;
+  camera.height = 90;
+  auto depth_at = [&](const cv::Mat_<float>& sparse, const Eigen::Vector2f& p, int fit_rows, double max_tilt_deg = 20.0) {
     rgbl::KeypointDepth out;
     rgbl::lookup_surface_depth(sparse, {}, 0.05F, std::span<const Eigen::Vector2f>(&p, 1),
-                               std::span<rgbl::KeypointDepth>(&out, 1), {fit_rows, f, f, 20.0, 0.0, 20.0});
+                               std::span<rgbl::KeypointDepth>(&out, 1), {fit_rows, camera, max_tilt_deg});
     return out;
   };
   // without the fit: the ring's depth, 4 % beyond the road under the keypoint
@@ -271,10 +276,7 @@ TEST_CASE("surface plane fit: a keypoint between two LiDAR rings on the road get
   CHECK(depth_at(step, pixel, 3).z == Approx(f * h / 50.0).epsilon(1e-6));
   CHECK_THROWS_AS(depth_at(rings, pixel, -1), rgbl::ConfigError);
 
-  rgbl::KeypointDepth out;
-  CHECK_THROWS_AS(rgbl::lookup_surface_depth(rings, {}, 0.05F, std::span<const Eigen::Vector2f>(&pixel, 1),
-                                             std::span<rgbl::KeypointDepth>(&out, 1), {3, f, f, 20.0, 0.0, 90.0}),
-                  rgbl::ConfigError);
+  CHECK_THROWS_AS(depth_at(rings, pixel, 3, 90.0), rgbl::ConfigError);
 
   // Only a surface about level below the camera is fitted (within 20 deg here). A plane n . X = d in
   // the camera's frame (y down) has 1/z = (n_x (u - 20) / f + n_y v / f + n_z) / d.
@@ -316,19 +318,13 @@ TEST_CASE("surface plane fit: a keypoint between two LiDAR rings on the road get
     for (const int v : {51, 53}) step_up(v, u) = 50.0F;
   }
   const Eigen::Vector2f at_50(20.0F, 50.0F);
-  rgbl::KeypointDepth on_step;
-  rgbl::lookup_surface_depth(step_up, {}, 0.05F, std::span<const Eigen::Vector2f>(&at_50, 1),
-                             std::span<rgbl::KeypointDepth>(&on_step, 1), {3, f, f, 20.0, 0.0, 89.0});
-  CHECK(on_step.z == Approx(50.0));
+  CHECK(depth_at(step_up, at_50, 3, 89.0).z == Approx(50.0));
   // the same rows on one plane (inverse depth affine in the row) are fitted
   cv::Mat_<float> ramp(90, 40, 0.0F);
   for (int u = 0; u < 40; ++u) {
     for (const int v : {47, 49, 51, 53}) ramp(v, u) = static_cast<float>(1.0 / (1.0 / 50.0 + (v - 51) * 1e-4));
   }
-  rgbl::KeypointDepth on_ramp;
-  rgbl::lookup_surface_depth(ramp, {}, 0.05F, std::span<const Eigen::Vector2f>(&at_50, 1),
-                             std::span<rgbl::KeypointDepth>(&on_ramp, 1), {3, f, f, 20.0, 0.0, 89.0});
-  CHECK(on_ramp.z == Approx(1.0 / (1.0 / 50.0 - 1e-4)).epsilon(1e-5));
+  CHECK(depth_at(ramp, at_50, 3, 89.0).z == Approx(1.0 / (1.0 / 50.0 - 1e-4)).epsilon(1e-5));
 }
 
 TEST_CASE("samples behind a foreground edge in the camera's view are dropped, a slanted road is kept") {

@@ -7,6 +7,7 @@
 // so even the rounding of M - (M - d) matches. Depths must lie in (0, M); others count as empty.
 
 #include "rgbl/depth/depth_source.hpp"
+#include "rgbl/geometry/camera.hpp"
 
 #include <Eigen/Core>
 #include <opencv2/core/mat.hpp>
@@ -78,8 +79,8 @@ KeypointDepth lookup_depth(const cv::Mat_<float>& sparse, const DilationOptions&
 // samples scatter about the plane by more than pixel rounding and range_sigma explain (3 sigma): far
 // away a depth step between two objects, which the surface's growth can cross, looks level.
 struct SurfacePlaneFit {
-  int rows = 0;  // px above and below the keypoint; 0 = off
-  double fx = 1.0, fy = 1.0, cx = 0.0, cy = 0.0;  // the camera's intrinsics, px
+  int rows = 0;          // px above and below the keypoint; 0 = off
+  PinholeCamera camera;  // the image's intrinsics (needed when rows > 0)
   double max_tilt_deg = 20.0;
   // The samples must lie on the plane within their rounding to pixel centres and this range noise, m.
   double range_sigma = 0.02;
