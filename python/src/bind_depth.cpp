@@ -15,7 +15,7 @@
 namespace rgbl::python {
 namespace {
 
-static_assert(sizeof(KeypointDepth) == 3 * sizeof(float), "KeypointDepth is returned as N x 3 float32");
+static_assert(sizeof(KeypointDepth) == 4 * sizeof(float), "KeypointDepth is returned as N x 4 float32");
 
 cv::Mat_<float> depth_view(const py::handle& object, const char* name, MatView& keep) {
   keep = mat_view(object, name);
@@ -153,12 +153,12 @@ void bind_depth(py::module_& m) {
             s.source->sample(px, depths);
             std::vector<KeypointDepth>* held = nullptr;
             const py::capsule base = owning_capsule(held, std::move(depths));
-            return py::array_t<float>({static_cast<py::ssize_t>(n), py::ssize_t{3}},
+            return py::array_t<float>({static_cast<py::ssize_t>(n), py::ssize_t{4}},
                                       reinterpret_cast<const float*>(held->data()), base);
           },
           py::arg("pixels"),
-          "Depth at pixels (float32 N x 2) after prepare(): float32 N x 3 of (z, distance in px to the measurement "
-          "it came from, depth spread under the kernel); z = 0: no depth.")
+          "Depth at pixels (float32 N x 2) after prepare(): float32 N x 4 of (z, distance in px to the measurement "
+          "it came from, depth spread under the kernel, depth gradient in m/px or 0 = unknown); z = 0: no depth.")
       .def("dense_depth", [](const PyDepthSource& s) { return mat_array(s.source->dense_depth()); },
            "The completed depth map of the prepared frame (float32 H x W, 0 = none).");
 

@@ -80,7 +80,7 @@ def test_lidar_source_samples_the_projected_point(camera):
     image = np.zeros((61, 101), np.uint8)
     source.prepare(image, np.array([[1.0, 2.0, 10.0, 0.0]], np.float32))
     out = source.sample(np.array([[60, 50], [61, 50], [60, 52], [10, 10]], np.float32))
-    assert out.shape == (4, 3) and out.dtype == np.float32
+    assert out.shape == (4, 4) and out.dtype == np.float32
     assert out[:, 0] == pytest.approx([10.0, 10.0, 10.0, 0.0])
     assert out[1, 1] == pytest.approx(1.0)  # one pixel from the measurement
     dense = source.dense_depth()

@@ -593,7 +593,11 @@ struct SurfaceScratch {
 // The plane through the surface's samples in a window fit.rows px tall, in inverse depth, at the
 // keypoint (lookup_surface_depth); nullopt when they do not bracket the keypoint's row or are too few.
 // min_cos_tilt: cos(fit.max_tilt_deg), once per call of lookup_surface_depth.
-std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius, float surface_tolerance,
+struct PlaneDepth {
+  float z;         // m
+  float gradient;  // |d z / d pixel|, m/px
+};
+std::optional<PlaneDepth> fit_surface_plane(const cv::Mat_<float>& sparse, int radius, float surface_tolerance,
                                        const SurfacePlaneFit& fit, double min_cos_tilt, const Eigen::Vector2f& pixel,
                                        float surface_z, SurfaceScratch& scratch) {
   const int cx = static_cast<int>(std::floor(pixel.x() + 0.5F)), cy = static_cast<int>(std::floor(pixel.y() + 0.5F));
@@ -674,7 +678,8 @@ std::optional<float> fit_surface_plane(const cv::Mat_<float>& sparse, int radius
   const double inverse_z = plane(0);
   const double z = 1.0 / inverse_z;
   if (!std::isfinite(z) || z <= 0.0 || std::abs(z - surface_z) > 3.0 * surface_tolerance * surface_z) return std::nullopt;
-  return static_cast<float>(z);
+  const double gradient = std::hypot(plane(1), plane(2)) * z * z;  // d(1/y) = -dy / y^2
+  return PlaneDepth{static_cast<float>(z), static_cast<float>(gradient)};
 }
 
 KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const Cell> cells, int radius,
@@ -726,8 +731,9 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
   }
   result.z = static_cast<float>(weights / inverse_depths);
   if (fit.rows > 0) {
-    if (const auto z = fit_surface_plane(sparse, radius, surface_tolerance, fit, min_cos_tilt, pixel, result.z, scratch)) {
-      result.z = *z;
+    if (const auto plane = fit_surface_plane(sparse, radius, surface_tolerance, fit, min_cos_tilt, pixel, result.z, scratch)) {
+      result.z = plane->z;
+      result.gradient = plane->gradient;
     }
   }
   result.sample_distance_px = std::sqrt(nearest2);

@@ -1,11 +1,13 @@
 #include "rgbl/backend/bundle_adjustment.hpp"
 #include "rgbl/backend/depth_noise.hpp"
 #include "rgbl/backend/pose_optimizer.hpp"
+#include "rgbl/core/error.hpp"
 
 #include "support/kitti_camera.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <numbers>
 #include <random>
 
 namespace {
@@ -203,4 +205,24 @@ TEST_CASE("depth noise model grows with depth and sample distance and rejects ed
   CHECK(m.sigma(10.0, 0.0, 5.0, fx) == 0.0);   // foreground/background edge
   CHECK(m.sigma(0.0, 0.0, 0.0, fx) == 0.0);
   CHECK(m.sigma(10.0, 0.0, 0.0, fx) == Approx(std::sqrt(0.03 * 0.03 + 0.05 * 0.05)));
+  CHECK(m.sigma(10.0, 0.0, 0.0, fx, 0.2) == m.sigma(10.0, 0.0, 0.0, fx));  // no registration term by default
+}
+
+TEST_CASE("depth noise model: a registration error weighs where the depth changes fast across the image") {
+  rgbl::DepthNoiseModel m;
+  m.registration_sigma_deg = 0.1;
+  const double fx = 707.0;
+  // 0.1 deg is 1.234 px at fx 707; on a road 20 m ahead of a camera 1.65 m up the depth changes by
+  // z^2 / (fx h) = 0.343 m per pixel
+  const double gradient = 20.0 * 20.0 / (fx * 1.65);
+  const double registration = 0.1 * std::numbers::pi / 180.0 * fx * gradient;
+  CHECK(registration == Approx(0.423).margin(1e-3));
+  CHECK(m.sigma(20.0, 0.0, 0.0, fx, gradient) ==
+        Approx(std::sqrt(0.03 * 0.03 + 0.1 * 0.1 + registration * registration)));
+  // a wall facing the camera (no gradient) keeps its sigma
+  CHECK(m.sigma(20.0, 0.0, 0.0, fx, 0.0) == Approx(std::sqrt(0.03 * 0.03 + 0.1 * 0.1)));
+  // on the road it grows with z^2, i.e. relative to z linearly: 8.5 % of z at 80 m
+  CHECK(m.sigma(80.0, 0.0, 0.0, fx, 80.0 * 80.0 / (fx * 1.65)) / 80.0 == Approx(0.0848).margin(5e-4));
+  m.registration_sigma_deg = -0.1;
+  CHECK_THROWS_AS(m.validate(), rgbl::ConfigError);
 }

@@ -265,6 +265,9 @@ TEST_CASE("surface plane fit: a keypoint between two LiDAR rings on the road get
   const rgbl::KeypointDepth fitted = depth_at(rings, pixel, 3);
   CHECK(fitted.z == Approx(f * h / 52.0).epsilon(1e-5));
   CHECK(fitted.sample_distance_px == Approx(2.0F));  // the kernel's samples, as without the fit
+  // and how fast the road's depth changes down the image there: |dz/dv| = f h / v^2 = z^2 / (f h)
+  CHECK(fitted.gradient == Approx(f * h / (52.0 * 52.0)).epsilon(1e-4));
+  CHECK(depth_at(rings, pixel, 0).gradient == 0.0F);  // the mean does not know it
   // a window that does not reach the second ring leaves the mean as it was (no extrapolation)
   CHECK(depth_at(rings, pixel, 2).z == Approx(f * h / 50.0).epsilon(1e-6));
   // nor does a keypoint beyond both rings: row 56 (only row 55 under its kernel) is not interpolated
@@ -293,7 +296,11 @@ TEST_CASE("surface plane fit: a keypoint between two LiDAR rings on the road get
   for (const Eigen::Vector3d& n : {Eigen::Vector3d(0.0, std::cos(10 * deg), std::sin(10 * deg)),
                                   Eigen::Vector3d(std::sin(15 * deg), std::cos(15 * deg), 0.0)}) {
     CAPTURE(n.transpose());
-    CHECK(depth_at(plane_rings(n, h), pixel, 3).z == Approx(z_on(n, h, 52)).epsilon(1e-5));
+    const rgbl::KeypointDepth on_plane = depth_at(plane_rings(n, h), pixel, 3);
+    CHECK(on_plane.z == Approx(z_on(n, h, 52)).epsilon(1e-5));
+    // z = h / (n . ray): the gradient is z^2 / (h f) times the normal's part across the image
+    const double z = z_on(n, h, 52);
+    CHECK(on_plane.gradient == Approx(z * z / (h * f) * std::hypot(n.x(), n.y())).epsilon(1e-4));
   }
   // keeping the ring's depth: a slope falling 30 deg, a wall leaning back 30 deg, a wall at 45 deg to
   // the view

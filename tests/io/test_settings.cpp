@@ -195,6 +195,11 @@ TEST_CASE("settings: rgbl's LiDAR occlusion keys", "[io][settings]") {
   CHECK_FALSE(unset.surface_fit_window_deg);
   CHECK_THAT(error_of(tmp.write("f.yaml", "%YAML:1.0\nLiDAR.SurfaceFitWindowDeg: 5\n")),
              Contains("'LiDAR.SurfaceFitWindowDeg': expected 0 (off) .. 5 deg"));
+  const auto registration = rgbl::read_settings(tmp.write("g.yaml", "%YAML:1.0\nLiDAR.RegistrationSigmaDeg: 0.2\n"));
+  CHECK(registration.registration_sigma_deg == 0.2);
+  CHECK_FALSE(unset.registration_sigma_deg);
+  CHECK_THAT(error_of(tmp.write("g2.yaml", "%YAML:1.0\nLiDAR.RegistrationSigmaDeg: -1\n")),
+             Contains("'LiDAR.RegistrationSigmaDeg': expected 0 (off) .. 5 deg"));
 }
 
 TEST_CASE("settings: LiDAR.TimeOffset, the image's time minus the scan's", "[io][settings]") {

@@ -16,6 +16,10 @@ struct DepthNoiseModel {
   // Triangulation-like growth sigma = sigma_quadratic * z^2 (ORB-SLAM's virtual baseline bf gives
   // 1 / bf here), for errors that grow with z^2: LiDAR-camera calibration and sync, motion distortion.
   double sigma_quadratic = 0.0;
+  // The scan's registration to the image is known to about this angle (LiDAR-camera calibration,
+  // sync): a depth read where it changes by g metres per pixel is off by up to g times that many pixels.
+  // Adds (registration_sigma_deg in px * gradient)^2; needs the source's gradient (KeypointDepth).
+  double registration_sigma_deg = 0.0;
   double max_spread = 1.0;          // m; above max(max_spread, max_spread_relative * z): a depth edge
   double max_spread_relative = 0.05;
   double min_depth = 0.1, max_depth = 120.0;  // m; depths outside are not used
@@ -24,7 +28,8 @@ struct DepthNoiseModel {
   void validate() const;
 
   // Standard deviation of a keypoint depth in metres, or 0 when the depth should not be used.
-  double sigma(double z, double sample_distance_px, double spread, double fx) const;
+  // gradient: the surface's depth change per pixel at the keypoint (m/px), 0 = unknown.
+  double sigma(double z, double sample_distance_px, double spread, double fx, double gradient = 0.0) const;
 };
 
 }  // namespace rgbl

@@ -40,6 +40,10 @@ struct KeypointDepth {
   float z = 0.0F;                   // camera depth (along the optical axis), metres
   float sample_distance_px = 0.0F;  // pixel distance to the real measurement the value came from
   float spread = 0.0F;              // max - min of valid depths under the kernel, metres (depth edge)
+  // How fast the surface's depth changes across the image at the keypoint, metres per pixel (the
+  // gradient's length); 0 when the source does not know it. A scan registered a little off the image
+  // (calibration, sync) reads the depth that far away: the noise model weights that.
+  float gradient = 0.0F;
 };
 
 // What a source reads from each frame besides the tracked image: a pipeline checks the dataset has

@@ -11,6 +11,7 @@
 //   LiDAR.MethodInverseDilation.KernelType, LiDAR.MethodInverseDilation.KernelSize_u,
 //   rgbl's own LiDAR.OcclusionWindowDeg (0 = off), LiDAR.OcclusionRatio (LidarSourceOptions::occlusion_*),
 //   LiDAR.SurfaceFitWindowDeg (LidarSourceOptions::surface_fit_window_deg, 0 = off),
+//   LiDAR.RegistrationSigmaDeg (DepthNoiseModel::registration_sigma_deg, 0 = off),
 //   LiDAR.TimeOffset (SystemOptions::scan_time_offset: the image's time minus the scan's, seconds;
 //   overrides the dataset's scan timestamps, 0 = simultaneous),
 //   rgbl's own Tracking.ReferenceLandmarkRatio (TrackerOptions::reference_landmark_ratio, 0..1) and
@@ -83,6 +84,7 @@ struct Settings {
   std::optional<double> occlusion_window_deg;  // LiDAR.OcclusionWindowDeg; unset = the source's default
   std::optional<double> occlusion_ratio;       // LiDAR.OcclusionRatio; unset = the source's default
   std::optional<double> surface_fit_window_deg;  // LiDAR.SurfaceFitWindowDeg; unset = the source's default (0, off)
+  std::optional<double> registration_sigma_deg;  // LiDAR.RegistrationSigmaDeg; unset = the model's default
   std::optional<double> scan_time_offset;      // LiDAR.TimeOffset, s; unset = the dataset's scan timestamps
   LoopClosingSettings loop_closing;
   std::optional<bool> place_culling;  // LocalMapping.PlaceCulling: keyframe culling by revisits
