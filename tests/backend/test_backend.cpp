@@ -205,7 +205,7 @@ TEST_CASE("depth noise model grows with depth and sample distance and rejects ed
   CHECK(m.sigma(10.0, 0.0, 5.0, fx) == 0.0);   // foreground/background edge
   CHECK(m.sigma(0.0, 0.0, 0.0, fx) == 0.0);
   CHECK(m.sigma(10.0, 0.0, 0.0, fx) == Approx(std::sqrt(0.03 * 0.03 + 0.05 * 0.05)));
-  CHECK(m.sigma(10.0, 0.0, 0.0, fx, 0.2) == m.sigma(10.0, 0.0, 0.0, fx));  // no registration term by default
+  CHECK(m.sigma(10.0, 0.0, 0.0, fx, 0.0) == m.sigma(10.0, 0.0, 0.0, fx));  // no gradient, no registration term
 }
 
 TEST_CASE("depth noise model: a registration error weighs where the depth changes fast across the image") {

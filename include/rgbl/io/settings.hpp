@@ -10,8 +10,8 @@
 //   LiDAR.Method, LiDAR.min_dist, LiDAR.max_dist, LiDAR.Tr11 .. LiDAR.Tr34 (T_cam_lidar, row-major),
 //   LiDAR.MethodInverseDilation.KernelType, LiDAR.MethodInverseDilation.KernelSize_u,
 //   rgbl's own LiDAR.OcclusionWindowDeg (0 = off), LiDAR.OcclusionRatio (LidarSourceOptions::occlusion_*),
-//   LiDAR.SurfaceFitWindowDeg (LidarSourceOptions::surface_fit_window_deg, 0 = off),
-//   LiDAR.RegistrationSigmaDeg (DepthNoiseModel::registration_sigma_deg, 0 = off),
+//   LiDAR.SurfaceFitWindowDeg (LidarSourceOptions::surface_fit_window_deg, 0 = off, the default),
+//   LiDAR.RegistrationSigmaDeg (DepthNoiseModel::registration_sigma_deg, 0 = off, default 0.1),
 //   LiDAR.TimeOffset (SystemOptions::scan_time_offset: the image's time minus the scan's, seconds;
 //   overrides the dataset's scan timestamps, 0 = simultaneous),
 //   rgbl's own Tracking.ReferenceLandmarkRatio (TrackerOptions::reference_landmark_ratio, 0..1) and
