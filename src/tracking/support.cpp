@@ -64,6 +64,25 @@ StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry
   check.allowed_translation_m = allowed_step(predicted_step_m, dt, options);
   check.translation_plausible = check.translation_m <= check.allowed_translation_m;
   check.plausible = check.translation_plausible && check.rotation_deg <= options.step_tolerance_rotation_deg;
+  check.allowed_shortfall_m = check.allowed_translation_m;
+  return check;
+}
+
+StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry3d& T_cam_world_predicted,
+                     const Eigen::Vector3d& last_centre, double dt, const TrackerOptions& options) {
+  const Eigen::Vector3d predicted_centre = T_cam_world_predicted.inverse().translation();
+  const Eigen::Vector3d step = predicted_centre - last_centre;
+  const double s = step.norm();
+  StepCheck check = check_step(T_cam_world, T_cam_world_predicted, s, dt, options);
+  const double reach = dt > 0.0 ? options.max_acceleration * dt * dt : 0.0;  // a dt^2
+  if (!(s > 0.0) || !(s < reach)) return check;  // the isotropic bound is the braking bound
+  check.shortfall_m = s - (T_cam_world.inverse().translation() - last_centre).dot(step / s);
+  const double braking = s - s * s / (2.0 * reach);
+  check.allowed_shortfall_m = options.step_tolerance + options.step_tolerance_relative * s + braking;
+  if (check.shortfall_m > check.allowed_shortfall_m) {
+    check.translation_plausible = false;
+    check.plausible = false;
+  }
   return check;
 }
 

@@ -413,9 +413,8 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   // rotation alone only with more support. Else the step is taken on the evidence a relocalisation
   // needs (and reported as a jump), else the frame keeps the prediction.
   const double dt = h.frame.timestamp - last_frame_->timestamp;
-  const double predicted_step =
-      (prediction.T_cam_world.inverse().translation() - prediction.T_last_world.inverse().translation()).norm();
-  const StepCheck step = check_step(h.frame.T_cam_world, prediction.T_cam_world, predicted_step, dt, options_);
+  const Eigen::Vector3d last_centre = prediction.T_last_world.inverse().translation();
+  const StepCheck step = check_step(h.frame.T_cam_world, prediction.T_cam_world, last_centre, dt, options_);
   if (step.plausible) return h;
   Frame candidate = h.frame;
   candidate.T_cam_world = prediction.T_cam_world;
@@ -424,11 +423,12 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   const LocalMapResult from_prediction =
       track_local_map(candidate, h.reference, h.relocalisation_frame, candidate_views);
   const StepCheck candidate_step =
-      check_step(candidate.T_cam_world, prediction.T_cam_world, predicted_step, dt, options_);
+      check_step(candidate.T_cam_world, prediction.T_cam_world, last_centre, dt, options_);
   const bool plausible_alternative = from_prediction.ok && candidate_step.plausible;
-  logger()->debug("frame {}: step {:.2f} m / {:.1f} deg off the prediction (allowed {:.2f} m) on {} inliers; "
-                  "from the prediction the local map finds {} ({:.2f} m off)", h.frame.index, step.translation_m,
-                  step.rotation_deg, step.allowed_translation_m, h.inliers, from_prediction.inliers,
+  logger()->debug("frame {}: step {:.2f} m / {:.1f} deg off the prediction (allowed {:.2f} m; {:.2f} m short of "
+                  "it, braking allows {:.2f} m) on {} inliers; from the prediction the local map finds {} ({:.2f} m "
+                  "off)", h.frame.index, step.translation_m, step.rotation_deg, step.allowed_translation_m,
+                  step.shortfall_m, step.allowed_shortfall_m, h.inliers, from_prediction.inliers,
                   candidate_step.translation_m);
   // A turn is judged on support: something moving in view shifts a pose locked on it by its own
   // displacement (metres at traffic speed) but cannot turn the whole scene, far points included; a
@@ -445,7 +445,7 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   std::optional<LidarView> lidar;  // built once, shared by the votes below
   const auto lidar_refuses = [&] {
     if (step.translation_plausible ||
-        check_step(h.frame.T_cam_world, candidate.T_cam_world, predicted_step, dt, options_).translation_plausible) {
+        check_step(h.frame.T_cam_world, candidate.T_cam_world, last_centre, dt, options_).translation_plausible) {
       return false;
     }
     // Returns as the units here: refusing a step keeps the prediction, the safe side, and a facade
@@ -473,7 +473,7 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
     // frame 54: the LiDAR voted 1010 to 238 against a 0.74 m step, then a relocalisation beside it on
     // 261 against 255 inliers was taken, and the map was lost six frames later).
     const auto lidar_refuses_relocalisation = [&] {
-      if (check_step(relocalised.frame.T_cam_world, prediction.T_cam_world, predicted_step, dt, options_)
+      if (check_step(relocalised.frame.T_cam_world, prediction.T_cam_world, last_centre, dt, options_)
               .translation_plausible) {
         return false;
       }
@@ -642,13 +642,12 @@ bool Tracker::within_reach(const Frame& frame, const Prediction& prediction) con
   if (!options_.check_steps || !velocity_ || !last_tracked_frame_) return true;
   const double dt = frame.timestamp - last_tracked_frame_->timestamp;
   if (!(dt > 0.0) || !std::isfinite(dt)) return true;
-  const double predicted_step =
-      (prediction.T_cam_world.inverse().translation() - last_tracked_frame_->T_cam_world.inverse().translation()).norm();
-  const StepCheck reach = check_step(frame.T_cam_world, prediction.T_cam_world, predicted_step, dt, options_);
+  const StepCheck reach = check_step(frame.T_cam_world, prediction.T_cam_world,
+                                     last_tracked_frame_->T_cam_world.inverse().translation(), dt, options_);
   if (reach.translation_plausible) return true;
   logger()->debug("frame {}: relocalisation rejected, {:.2f} m from the constant-velocity guess {:.2f} s after the last "
-                  "tracked frame (within reach: {:.2f} m)", frame.index, reach.translation_m, dt,
-                  reach.allowed_translation_m);
+                  "tracked frame (within reach: {:.2f} m), {:.2f} m short of it (braking allows {:.2f} m)", frame.index,
+                  reach.translation_m, dt, reach.allowed_translation_m, reach.shortfall_m, reach.allowed_shortfall_m);
   return false;
 }
 

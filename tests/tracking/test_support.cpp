@@ -71,6 +71,46 @@ TEST_CASE("support: a step is plausible within pose noise, velocity error and 1 
   CHECK(rgbl::check_step(predicted, predicted, 1.3, 0.0, options).allowed_translation_m == Approx(0.38));
 }
 
+TEST_CASE("support: after a gap a car that was moving cannot have stayed put: it brakes, it does not reverse",
+          "[tracking][support]") {
+  const rgbl::TrackerOptions options;  // 1 g
+  const Eigen::Vector3d last(0.0, 0.0, 0.0);
+  // 11.2 m/s, 2.1 s since the last frame (suburban seed 2, frames 15-34 left out): 23.52 m predicted.
+  // Braking at 1 g it stops after 1.12 s and 6.27 m, so it falls short by at most 17.25 m (+ 0.25 m +
+  // 10 % of the step); the isotropic bound alone allows 0.25 + 2.35 + 22.05 m either way.
+  const double s = 11.2 * 2.1, reach = 10.0 * 2.1 * 2.1;
+  const Eigen::Isometry3d predicted = camera_at(0.0, s);
+  const double allowed_short = 0.25 + 0.1 * s + (s - s * s / (2.0 * reach));
+  CHECK(allowed_short == Approx(0.25 + 2.352 + 17.248).margin(1e-3));
+  const auto at = [&](double x, double z) { return rgbl::check_step(camera_at(x, z), predicted, last, 2.1, options); };
+  // where it was before the gap: 23.5 m short, within the isotropic 24.65 m, but not within braking
+  const auto stayed = at(0.0, 0.0);
+  CHECK(stayed.translation_m == Approx(s));
+  CHECK(stayed.translation_m < stayed.allowed_translation_m);
+  CHECK(stayed.shortfall_m == Approx(s));
+  CHECK(stayed.allowed_shortfall_m == Approx(allowed_short));
+  CHECK_FALSE(stayed.translation_plausible);
+  CHECK_FALSE(stayed.plausible);
+  // braking hard and stopping early is within reach; so is going on, or further, as before
+  CHECK(at(0.0, s - allowed_short + 0.05).plausible);
+  CHECK_FALSE(at(0.0, s - allowed_short - 0.05).plausible);
+  CHECK(at(0.0, s + 20.0).plausible);
+  CHECK(at(0.0, s + 20.0).shortfall_m == Approx(-20.0));
+  // sideways is not short: the isotropic bound judges it
+  CHECK(at(10.0, s).plausible);
+  CHECK(at(10.0, s).shortfall_m == Approx(0.0).margin(1e-9));
+  // at 10 Hz a car at speed cannot stop within the frame: exactly the isotropic bound, as without the
+  // last centre
+  const Eigen::Isometry3d next = camera_at(0.0, 1.3);
+  for (const double z : {0.0, 0.5, 0.7, 1.3, 2.0}) {
+    const auto with_last = rgbl::check_step(camera_at(0.0, z), next, last, 0.1, options);
+    const auto without = rgbl::check_step(camera_at(0.0, z), next, 1.3, 0.1, options);
+    CAPTURE(z);
+    CHECK(with_last.plausible == without.plausible);
+    CHECK(with_last.allowed_translation_m == Approx(without.allowed_translation_m));
+  }
+}
+
 TEST_CASE("support: the thresholds are validated", "[tracking][support]") {
   rgbl::TrackerOptions options;
   options.min_ok_inliers = 5;  // below min_pose_inliers (10)

@@ -82,6 +82,10 @@ struct StepCheck {
   double translation_m = 0.0;    // distance between the two camera centres
   double rotation_deg = 0.0;     // angle of the relative rotation
   double allowed_translation_m = 0.0;
+  // How far the centre fell short of the predicted step along it, and how far braking can explain
+  // (the overload with the last centre; 0 and the isotropic bound otherwise).
+  double shortfall_m = 0.0;
+  double allowed_shortfall_m = 0.0;
   bool translation_plausible = true;  // the centre within reach (the rotation may still be off)
   bool plausible = true;
 };
@@ -90,5 +94,14 @@ struct StepCheck {
 // dt the time since the previous frame (its acceleration tolerance; <= 0: unknown, not counted).
 StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry3d& T_cam_world_predicted,
                      double predicted_step_m, double dt, const TrackerOptions& options);
+
+// The same, the predicted step running from the last centre (world frame), and a vehicle does not
+// reverse: braking at max_acceleration from the speed s / dt, it still covers s^2 / (2 a dt^2) when it
+// stops within dt (s < a dt^2), so it falls short of the predicted step by at most s - s^2 / (2 a dt^2)
+// there, less than the isotropic a dt^2 / 2. Only after a gap or a slow frame rate does that bind (at
+// 10 Hz and 1 g it takes a step under 0.1 m): a frame placed where the car was before a 2 s gap,
+// 23.6 m short at 11 m/s, is not within reach, though 23.6 m is within a dt^2 / 2 = 22 m + tolerance.
+StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry3d& T_cam_world_predicted,
+                     const Eigen::Vector3d& last_centre, double dt, const TrackerOptions& options);
 
 }  // namespace rgbl
