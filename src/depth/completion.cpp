@@ -590,16 +590,18 @@ struct SurfaceScratch {
   std::vector<SurfaceSample> tall;  // the plane fit's taller window
 };
 
+// The fitted plane at the keypoint.
+struct PlaneDepth {
+  float z;         // m
+  float gradient;  // |dz / d pixel|, m/px
+};
+
 // The plane through the surface's samples in a window fit.rows px tall, in inverse depth, at the
 // keypoint (lookup_surface_depth); nullopt when they do not bracket the keypoint's row or are too few.
 // min_cos_tilt: cos(fit.max_tilt_deg), once per call of lookup_surface_depth.
-struct PlaneDepth {
-  float z;         // m
-  float gradient;  // |d z / d pixel|, m/px
-};
 std::optional<PlaneDepth> fit_surface_plane(const cv::Mat_<float>& sparse, int radius, float surface_tolerance,
-                                       const SurfacePlaneFit& fit, double min_cos_tilt, const Eigen::Vector2f& pixel,
-                                       float surface_z, SurfaceScratch& scratch) {
+                                            const SurfacePlaneFit& fit, double min_cos_tilt,
+                                            const Eigen::Vector2f& pixel, float surface_z, SurfaceScratch& scratch) {
   const int cx = static_cast<int>(std::floor(pixel.x() + 0.5F)), cy = static_cast<int>(std::floor(pixel.y() + 0.5F));
   auto& tall = scratch.tall;
   tall.clear();
@@ -678,7 +680,7 @@ std::optional<PlaneDepth> fit_surface_plane(const cv::Mat_<float>& sparse, int r
   const double inverse_z = plane(0);
   const double z = 1.0 / inverse_z;
   if (!std::isfinite(z) || z <= 0.0 || std::abs(z - surface_z) > 3.0 * surface_tolerance * surface_z) return std::nullopt;
-  const double gradient = std::hypot(plane(1), plane(2)) * z * z;  // d(1/y) = -dy / y^2
+  const double gradient = std::hypot(plane(1), plane(2)) * z * z;  // z = 1 / y: dz = -dy z^2
   return PlaneDepth{static_cast<float>(z), static_cast<float>(gradient)};
 }
 
