@@ -47,6 +47,15 @@ LocalMappingStats LocalMapper::process(KeyframeId keyframe, const std::vector<La
   return stats;
 }
 
+void LocalMapper::watch_initial(KeyframeId id) {
+  std::shared_lock lock(map_.mutex());
+  const Keyframe* kf = map_.keyframe(id);
+  if (kf == nullptr) return;
+  for (const LandmarkId l : kf->landmarks) {
+    if (l.valid()) initial_landmarks_.push_back(l);
+  }
+}
+
 void LocalMapper::associate(KeyframeId id) {
   Keyframe* kf = map_.keyframe(id);
   if (kf == nullptr) return;
@@ -72,6 +81,18 @@ int LocalMapper::cull_landmarks(KeyframeId current) {
     }
   }
   recent_landmarks_ = std::move(keep);
+  keep.clear();
+  for (const LandmarkId id : initial_landmarks_) {
+    const Landmark* l = map_.landmark(id);
+    if (l == nullptr) continue;
+    if (l->found_ratio() < options_.min_found_ratio) {
+      map_.erase_landmark(id);
+      ++culled;
+    } else if (current.value - l->first_keyframe.value < 3) {
+      keep.push_back(id);
+    }
+  }
+  initial_landmarks_ = std::move(keep);
   return culled;
 }
 

@@ -115,6 +115,7 @@ struct System::Impl {
     KeyframeId keyframe;
     std::vector<LidarPoint> scan;
     std::vector<LandmarkId> depth_landmarks;  // made with the keyframe (threaded mapping)
+    bool initial = false;  // a map's first keyframe: its landmarks only join the culling
   };
 
   // Threaded mapping, and loop closing (with threaded mapping) fed by it once a keyframe is mapped.
@@ -171,10 +172,14 @@ struct System::Impl {
     while (std::optional<KeyframeJob> next = mapping_queue.pop(/*drain=*/true)) {
       const bool mapped = run_job([&] {
         std::lock_guard gate(mapping_gate);
-        mapper.process(next->keyframe, next->depth_landmarks);
+        if (next->initial) {
+          mapper.watch_initial(next->keyframe);
+        } else {
+          mapper.process(next->keyframe, next->depth_landmarks);
+        }
       });
-      // before done(): finish() sees it
-      if (mapped && threaded_loop_closing()) loop_queue.push(std::move(*next));
+      // before done(): finish() sees it; a first keyframe went to the loop thread from track()
+      if (mapped && !next->initial && threaded_loop_closing()) loop_queue.push(std::move(*next));
       mapping_queue.done();
     }
   }
@@ -306,6 +311,14 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
     return s.threaded_loop_closing() ? std::vector<LidarPoint>(sensor.scan.begin(), sensor.scan.end())
                                      : std::vector<LidarPoint>{};
   };
+  if (outcome.initialised_now) {
+    const KeyframeId first = s.tracker.reference_keyframe();
+    if (s.options.threaded_mapping) {
+      s.mapping_queue.push({first, {}, {}, true});
+    } else {
+      s.mapper.watch_initial(first);
+    }
+  }
   if (new_keyframe.valid()) {
     if (s.options.threaded_mapping) {
       // The keyframe's depth points become landmarks now, on this thread: the next frames track

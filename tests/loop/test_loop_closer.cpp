@@ -55,6 +55,10 @@ TEST_CASE("loop closer: a revisit of real keyframes with drift is closed and cor
   rgbl::SystemOptions no_loops;
   no_loops.loop_closing.enabled = false;
   const rgbl::test::Mapped m = rgbl::test::map_drive(sequence, 30, no_loops);
+  // the car ahead in frame 0 leaves nothing a revisit could be aligned to
+  const int unfound = rgbl::test::unfound_first_keyframe_landmarks(m.system->map(), no_loops.mapping.min_found_ratio);
+  CAPTURE(unfound);  // measured: 9 inline after 30 frames, 6 threaded after 20 (341 and 339 before)
+  CHECK(unfound <= 30);
   rgbl::Map map;
   copy_map(m.system->map(), map);
   const auto originals = map.keyframe_ids();
@@ -111,7 +115,7 @@ TEST_CASE("loop closer: a revisit of real keyframes with drift is closed and cor
   CHECK(closure->correction_m > 1.0);
   CHECK(closer.loops().size() == 3);
   CHECK(closer.stats().confirming >= 1);
-  // the revisits had no landmarks: fusion gives them the originals' (measured: 106 fused), and the
+  // the revisits had no landmarks: fusion gives them the originals' (measured: 192 fused), and the
   // global bundle adjustment takes every keyframe of the map
   CHECK(closure->fused_landmarks >= 50);
   CHECK(map.keyframe(revisits[0])->covisibility.contains(originals[0]));

@@ -458,7 +458,9 @@ TEST_CASE("a gap in a bend along a hedge: the scans registered across it place t
   CHECK(registered.error[after] < 0.2);
   CHECK(worst_after(registered) < 0.3);
   CHECK(registered.ate < 0.1);
-  CHECK(guessed.error[after] > 2.0);  // what the images alone take, for the record
+  // Without the registration the images alone took the look-alike (8.4 m) until 2026-12-05; since the
+  // first keyframe's landmarks are culled like any other's they find frame 40 here (0.14 m), and with
+  // the ring plane fit on they take the hedge again (10.7 m): a chaotic outcome, printed, not asserted.
 }
 
 TEST_CASE("braking in a gap, then no images: the lost frames keep the scans' motion, not the speed from before") {

@@ -115,3 +115,74 @@ TEST_CASE("local mapping checks its keyframe pair options (naming the field)") {
   o.pairs.odometry_sigma_translation = -0.05;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("keyframe_pairs.odometry_sigma_translation"));
 }
+
+namespace {
+
+// Three keyframes 0.5 m apart; the first keyframe's landmarks are all its keypoints' points, the
+// later two observe only the even ones. Points 0-9 were predicted visible in 13 frames and found in
+// one (a car driving ahead: it keeps its place in the image, not in the world), the rest found in 8 of
+// 10. Returns which of the first keyframe's landmarks are left after local mapping of the later two.
+struct FirstKeyframeCulling {
+  int car_left = 0, static_left = 0, seen_once_left = 0;
+};
+FirstKeyframeCulling cull_after_first_keyframe(bool watched) {
+  rgbl::test::PointsMap s = rgbl::test::make_points_map(3, 60, 5);
+  rgbl::Map map;
+  std::vector<rgbl::LandmarkId> landmark(s.points.size());
+  const rgbl::KeyframeId first = map.add_keyframe(rgbl::test::make_points_keyframe(s, 0, s.T_cam_world[0]));
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    const int keypoint = s.keypoint_of_point[0][i];
+    if (keypoint < 0) continue;
+    landmark[i] = map.add_landmark(s.points[i], first);
+    map.add_observation(landmark[i], first, keypoint);
+    map.landmark(landmark[i])->visible = i < 10 ? 13 : 10;
+    map.landmark(landmark[i])->found = i < 10 ? 1 : 8;
+  }
+  map.update_covisibility(first);
+  rgbl::LocalMappingOptions options;
+  options.local_ba = false;
+  options.fusion = false;
+  options.keyframe_culling = false;
+  options.max_new_depth_points = 0;
+  rgbl::LocalMapper mapper(map, s.camera, options);
+  if (watched) mapper.watch_initial(first);
+  for (int k = 1; k < 3; ++k) {
+    const rgbl::KeyframeId id = map.add_keyframe(rgbl::test::make_points_keyframe(s, k, s.T_cam_world[static_cast<std::size_t>(k)]));
+    for (std::size_t i = 0; i < s.points.size(); i += 2) {
+      const int keypoint = s.keypoint_of_point[static_cast<std::size_t>(k)][i];
+      if (keypoint < 0 || !landmark[i].valid()) continue;
+      map.keyframe(id)->landmarks[static_cast<std::size_t>(keypoint)] = landmark[i];
+      map.add_observation(landmark[i], id, keypoint);
+    }
+    mapper.process(id);
+  }
+  FirstKeyframeCulling left;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    if (!landmark[i].valid() || map.landmark(landmark[i]) == nullptr) continue;
+    if (i < 10) {
+      ++left.car_left;
+    } else if (i % 2 == 0) {
+      ++left.static_left;
+    } else {
+      ++left.seen_once_left;
+    }
+  }
+  return left;
+}
+
+}  // namespace
+
+TEST_CASE("the first keyframe's landmarks are culled by their found ratio, not by their observations") {
+  const FirstKeyframeCulling unwatched = cull_after_first_keyframe(false);
+  const FirstKeyframeCulling watched = cull_after_first_keyframe(true);
+  // every point of the scene is in view of the first keyframe (6-14 m ahead, +-3 m across)
+  const int total = unwatched.car_left + unwatched.static_left + unwatched.seen_once_left;
+  REQUIRE(total == 60);
+  CHECK(unwatched.car_left == 10);  // without it nothing of the first keyframe is ever culled
+  CHECK(watched.car_left == 0);
+  CHECK(watched.static_left == unwatched.static_left);
+  CHECK(watched.static_left == 25);
+  // seen by the first keyframe alone, but found whenever predicted: kept (the return of a loop to the
+  // drive's start needs them)
+  CHECK(watched.seen_once_left == 25);
+}

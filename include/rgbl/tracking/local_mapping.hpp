@@ -37,6 +37,15 @@ class LocalMapper {
   // against max_new_depth_points, and keypoints left without a landmark by culling get new ones.
   LocalMappingStats process(KeyframeId keyframe, const std::vector<LandmarkId>& created_with_keyframe = {});
 
+  // A map's first keyframe is made by tracking's initialisation, not by process(): its landmarks are
+  // put under the found-ratio rule of every later keyframe's for the same two keyframes. Without it a
+  // point on a car driving ahead in the first frame, predicted visible in a dozen frames and found in
+  // none, stays in the map for good, and a loop verification can align a revisit to that car rather
+  // than to the street (2026-12-05). The min_observations rule is left out: it also takes the points
+  // the return of a loop to the drive's start needs (the simulator's loop tests lose their closures).
+  // Takes the map lock itself.
+  void watch_initial(KeyframeId keyframe);
+
   // Asks a running bundle adjustment to stop early (e.g. when a new keyframe is waiting).
   void request_abort() { abort_ = true; }
 
@@ -52,6 +61,7 @@ class LocalMapper {
   PinholeCamera camera_;
   LocalMappingOptions options_;
   std::vector<LandmarkId> recent_landmarks_;
+  std::vector<LandmarkId> initial_landmarks_;  // of a map's first keyframe: the found-ratio rule only
   std::atomic<bool> abort_{false};
 };
 
