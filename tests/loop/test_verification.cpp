@@ -84,7 +84,7 @@ void build(CopiedMap& m, const Eigen::Vector3d& offset) {
 // A map of one keyframe at the origin: 150 street points, half of them with a copy 4 m along the street
 // (a repeated facade: their descriptor matches are ambiguous and dropped), and 100 points on a car 20 m
 // ahead. The current keyframe is 5 m further on and sees the street where it is and the car again 20 m
-// ahead (it drove on with the camera): by descriptors the car outnumbers the street, 100 to about 75.
+// ahead (it drove on with the camera): by descriptors the car outnumbers the street, 100 to 90.
 struct CarAheadMap {
   rgbl::PinholeCamera camera{.fx = 700.0, .fy = 700.0, .cx = 610.0, .cy = 185.0, .width = 1226, .height = 370};
   rgbl::Map map;
