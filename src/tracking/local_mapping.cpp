@@ -27,11 +27,11 @@ LocalMappingStats LocalMapper::process(KeyframeId keyframe, const std::vector<La
     associate(keyframe);
     stats.culled_landmarks = cull_landmarks(keyframe);
     for (const LandmarkId l : created_with_keyframe) {
-      if (map_.landmark(l) != nullptr) recent_landmarks_.push_back(l);
+      if (map_.landmark(l) != nullptr) recent_landmarks_.push_back({l, false});
     }
     const int budget = options_.max_new_depth_points - static_cast<int>(created_with_keyframe.size());
     const std::vector<LandmarkId> created = create_depth_landmarks(map_, camera_, keyframe, std::max(budget, 0));
-    recent_landmarks_.insert(recent_landmarks_.end(), created.begin(), created.end());
+    for (const LandmarkId l : created) recent_landmarks_.push_back({l, false});
     stats.new_landmarks = static_cast<int>(created_with_keyframe.size() + created.size());
     if (options_.fusion) stats.fused_landmarks = fuse(keyframe);
   }
@@ -52,7 +52,7 @@ void LocalMapper::watch_initial(KeyframeId id) {
   const Keyframe* kf = map_.keyframe(id);
   if (kf == nullptr) return;
   for (const LandmarkId l : kf->landmarks) {
-    if (l.valid()) initial_landmarks_.push_back(l);
+    if (l.valid()) recent_landmarks_.push_back({l, true});
   }
 }
 
@@ -67,32 +67,20 @@ void LocalMapper::associate(KeyframeId id) {
 
 int LocalMapper::cull_landmarks(KeyframeId current) {
   int culled = 0;
-  std::vector<LandmarkId> keep;
-  for (const LandmarkId id : recent_landmarks_) {
-    const Landmark* l = map_.landmark(id);
+  std::vector<WatchedLandmark> keep;
+  for (const WatchedLandmark& w : recent_landmarks_) {
+    const Landmark* l = map_.landmark(w.id);
     if (l == nullptr) continue;
     const int age = current.value - l->first_keyframe.value;
     if (l->found_ratio() < options_.min_found_ratio ||
-        (age >= 2 && static_cast<int>(l->observations.size()) < options_.min_observations)) {
-      map_.erase_landmark(id);
+        (!w.initial && age >= 2 && static_cast<int>(l->observations.size()) < options_.min_observations)) {
+      map_.erase_landmark(w.id);
       ++culled;
     } else if (age < 3) {
-      keep.push_back(id);
+      keep.push_back(w);
     }
   }
   recent_landmarks_ = std::move(keep);
-  keep.clear();
-  for (const LandmarkId id : initial_landmarks_) {
-    const Landmark* l = map_.landmark(id);
-    if (l == nullptr) continue;
-    if (l->found_ratio() < options_.min_found_ratio) {
-      map_.erase_landmark(id);
-      ++culled;
-    } else if (current.value - l->first_keyframe.value < 3) {
-      keep.push_back(id);
-    }
-  }
-  initial_landmarks_ = std::move(keep);
   return culled;
 }
 

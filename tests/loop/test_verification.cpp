@@ -12,128 +12,44 @@
 
 namespace {
 
-// A map of one keyframe at the origin seeing `points` twice: each landmark has a copy `offset` away
-// whose descriptor differs in 4 bits, as two keyframes leave one point when their landmarks were never
-// fused (offset of centimetres) or as a repeated facade does (offset of metres). The current keyframe,
-// at T_cam_world in that map, sees each original once, its descriptor 12 bits off, with exact depth.
-struct CopiedMap {
+// A map of one keyframe at the origin and a current keyframe at T_cam_world in that map (the truth).
+struct OneKeyframeMap {
   rgbl::PinholeCamera camera{.fx = 700.0, .fy = 700.0, .cx = 610.0, .cy = 185.0, .width = 1226, .height = 370};
   rgbl::Map map;
   rgbl::KeyframeId matched;
   rgbl::Keyframe current;
-  Eigen::Isometry3d T_cam_world;  // of the current keyframe: the truth
+  Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();
 };
 
-void build(CopiedMap& m, const Eigen::Vector3d& offset) {
-  m.T_cam_world = Eigen::Isometry3d(Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitY()));
-  m.T_cam_world.translation() = Eigen::Vector3d(0.4, 0.0, -2.0);  // 2 m ahead, 0.4 m to the left
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> x(-12.0, 12.0), y(-3.0, 1.5), z(6.0, 30.0);
-  auto flip = [&](rgbl::Descriptor d, int bits) {
-    for (int b = 0; b < bits; ++b) {
-      const unsigned bit = rng() % 256U;
-      d[bit / 8U] ^= static_cast<std::uint8_t>(1U << (bit % 8U));
-    }
-    return d;
-  };
-  struct Point {
-    Eigen::Vector3d p;
-    rgbl::Descriptor d;
-  };
-  std::vector<Point> points;
-  while (points.size() < 150) {
-    const Eigen::Vector3d p(x(rng), y(rng), z(rng));
-    const auto seen = [&](const Eigen::Isometry3d& T) {
-      const auto px = m.camera.project(T * p);
-      return px && m.camera.in_image(*px);
-    };
-    if (!seen(Eigen::Isometry3d::Identity()) || !seen(m.T_cam_world)) continue;
-    rgbl::Descriptor d;
-    for (auto& byte : d) byte = static_cast<std::uint8_t>(rng());
-    points.push_back({p, d});
-  }
-  // each point and its copy, in the order of the matched keyframe's keypoints
-  std::vector<Point> mapped;
-  for (const Point& point : points) {
-    mapped.push_back(point);
-    mapped.push_back({point.p + offset, flip(point.d, 4)});
-  }
-  rgbl::Keyframe matched;
-  for (const Point& point : mapped) {
-    const auto px = m.camera.project(point.p);  // a copy may fall outside: its keypoint is never searched
-    matched.keypoints.push_back({.x = static_cast<float>(px ? px->x() : 0.0), .y = static_cast<float>(px ? px->y() : 0.0)});
-    matched.descriptors.push_back(point.d);
-    matched.depth.push_back(static_cast<float>(point.p.z()));
-  }
-  matched.landmarks.resize(matched.keypoints.size());
-  m.matched = m.map.add_keyframe(std::move(matched));
-  for (std::size_t i = 0; i < mapped.size(); ++i) {
-    const rgbl::LandmarkId id = m.map.add_landmark(mapped[i].p, m.matched);
-    m.map.add_observation(id, m.matched, static_cast<int>(i));
-    m.map.update_landmark(id);  // its descriptor: the one observation's
-  }
-  for (const Point& point : points) {
-    const Eigen::Vector3d p_cam = m.T_cam_world * point.p;
-    const auto px = m.camera.project(p_cam);
-    m.current.keypoints.push_back({.x = static_cast<float>(px->x()), .y = static_cast<float>(px->y())});
-    m.current.descriptors.push_back(flip(point.d, 12));
-    m.current.depth.push_back(static_cast<float>(p_cam.z()));
-  }
+// A point with its descriptor: `p` in the map, `seen` in the current camera.
+struct Point {
+  Eigen::Vector3d p;
+  Eigen::Vector3d seen;
+  rgbl::Descriptor d;
+};
+
+rgbl::Descriptor random_descriptor(std::mt19937& rng) {
+  rgbl::Descriptor d;
+  for (auto& byte : d) byte = static_cast<std::uint8_t>(rng());
+  return d;
 }
 
-// A map of one keyframe at the origin: 150 street points, half of them with a copy 4 m along the street
-// (a repeated facade: their descriptor matches are ambiguous and dropped), and 100 points on a car 20 m
-// ahead. The current keyframe is 5 m further on and sees the street where it is and the car again 20 m
-// ahead (it drove on with the camera): by descriptors the car outnumbers the street, 100 to 90.
-struct CarAheadMap {
-  rgbl::PinholeCamera camera{.fx = 700.0, .fy = 700.0, .cx = 610.0, .cy = 185.0, .width = 1226, .height = 370};
-  rgbl::Map map;
-  rgbl::KeyframeId matched;
-  rgbl::Keyframe current;
-  Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();  // of the current keyframe: the truth
-};
+rgbl::Descriptor flip(rgbl::Descriptor d, int bits, std::mt19937& rng) {
+  for (int b = 0; b < bits; ++b) {
+    const unsigned bit = rng() % 256U;
+    d[bit / 8U] ^= static_cast<std::uint8_t>(1U << (bit % 8U));
+  }
+  return d;
+}
 
-void build_car_ahead(CarAheadMap& m) {
-  m.T_cam_world.translation() = Eigen::Vector3d(0.0, 0.0, -5.0);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> x(-12.0, 12.0), y(-3.0, 1.5), z(8.0, 30.0);
-  std::uniform_real_distribution<double> car_x(-0.9, 0.9), car_y(-0.6, 0.8), car_z(19.6, 20.4);
-  const auto random_descriptor = [&] {
-    rgbl::Descriptor d;
-    for (auto& byte : d) byte = static_cast<std::uint8_t>(rng());
-    return d;
-  };
-  const auto flip = [&](rgbl::Descriptor d, int bits) {
-    for (int b = 0; b < bits; ++b) {
-      const unsigned bit = rng() % 256U;
-      d[bit / 8U] ^= static_cast<std::uint8_t>(1U << (bit % 8U));
-    }
-    return d;
-  };
-  struct Point {
-    Eigen::Vector3d p;     // in the map
-    Eigen::Vector3d seen;  // in the current camera
-    rgbl::Descriptor d;
-  };
-  std::vector<Point> street, car, copies;
-  const auto in_view = [&](const Eigen::Vector3d& p_cam) {
-    const auto px = m.camera.project(p_cam);
-    return px && m.camera.in_image(*px);
-  };
-  while (street.size() < 150) {
-    const Eigen::Vector3d p(x(rng), y(rng), z(rng));
-    if (std::abs(p.x()) < 2.0 && p.z() > 15.0) continue;  // the car's lane ahead
-    if (!in_view(p) || !in_view(m.T_cam_world * p)) continue;
-    street.push_back({p, m.T_cam_world * p, random_descriptor()});
-    if (street.size() % 2 == 0) copies.push_back({p + Eigen::Vector3d(4.0, 0.0, 0.0), p, flip(street.back().d, 4)});
-  }
-  while (car.size() < 100) {
-    const Eigen::Vector3d p(car_x(rng), car_y(rng), car_z(rng));
-    car.push_back({p, p, random_descriptor()});
-  }
-  std::vector<Point> mapped = street;
-  mapped.insert(mapped.end(), copies.begin(), copies.end());
-  mapped.insert(mapped.end(), car.begin(), car.end());
+bool in_view(const rgbl::PinholeCamera& camera, const Eigen::Vector3d& p_cam) {
+  const auto px = camera.project(p_cam);
+  return px && camera.in_image(*px);
+}
+
+// The map's keyframe at the origin: one keypoint per point at its exact projection (a point outside
+// the image gets a keypoint that is never searched) and one landmark per keypoint, exact.
+void add_matched(OneKeyframeMap& m, const std::vector<Point>& mapped) {
   rgbl::Keyframe matched;
   for (const Point& point : mapped) {
     const auto px = m.camera.project(point.p);
@@ -146,23 +62,80 @@ void build_car_ahead(CarAheadMap& m) {
   for (std::size_t i = 0; i < mapped.size(); ++i) {
     const rgbl::LandmarkId id = m.map.add_landmark(mapped[i].p, m.matched);
     m.map.add_observation(id, m.matched, static_cast<int>(i));
-    m.map.update_landmark(id);
+    m.map.update_landmark(id);  // its descriptor: the one observation's
   }
-  std::vector<Point> seen = street;
-  seen.insert(seen.end(), car.begin(), car.end());
+}
+
+// The current keyframe's keypoints: each point where its camera sees it, its descriptor 12 bits off,
+// exact depth.
+void add_current(OneKeyframeMap& m, const std::vector<Point>& seen, std::mt19937& rng) {
   for (const Point& point : seen) {
     const auto px = m.camera.project(point.seen);
     m.current.keypoints.push_back({.x = static_cast<float>(px->x()), .y = static_cast<float>(px->y())});
-    m.current.descriptors.push_back(flip(point.d, 12));
+    m.current.descriptors.push_back(flip(point.d, 12, rng));
     m.current.depth.push_back(static_cast<float>(point.seen.z()));
   }
+}
+
+// 150 points, each with a copy `offset` away whose descriptor differs in 4 bits, as two keyframes
+// leave one point when their landmarks were never fused (offset of centimetres) or as a repeated
+// facade does (offset of metres). The current keyframe sees each original once.
+void build(OneKeyframeMap& m, const Eigen::Vector3d& offset) {
+  m.T_cam_world = Eigen::Isometry3d(Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitY()));
+  m.T_cam_world.translation() = Eigen::Vector3d(0.4, 0.0, -2.0);  // 2 m ahead, 0.4 m to the left
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> x(-12.0, 12.0), y(-3.0, 1.5), z(6.0, 30.0);
+  std::vector<Point> points;
+  while (points.size() < 150) {
+    const Eigen::Vector3d p(x(rng), y(rng), z(rng));
+    if (!in_view(m.camera, p) || !in_view(m.camera, m.T_cam_world * p)) continue;
+    points.push_back({p, m.T_cam_world * p, random_descriptor(rng)});
+  }
+  // each point and its copy, in the order of the matched keyframe's keypoints
+  std::vector<Point> mapped;
+  for (const Point& point : points) {
+    mapped.push_back(point);
+    mapped.push_back({point.p + offset, point.seen, flip(point.d, 4, rng)});
+  }
+  add_matched(m, mapped);
+  add_current(m, points, rng);
+}
+
+// 150 street points, half of them with a copy 4 m along the street (a repeated facade: their
+// descriptor matches are ambiguous and dropped), and 100 points on a car 20 m ahead. The current
+// keyframe is 5 m further on and sees the street where it is and the car again 20 m ahead (it drove
+// on with the camera): by descriptors the car outnumbers the street, 100 to 90.
+void build_car_ahead(OneKeyframeMap& m) {
+  m.T_cam_world.translation() = Eigen::Vector3d(0.0, 0.0, -5.0);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> x(-12.0, 12.0), y(-3.0, 1.5), z(8.0, 30.0);
+  std::uniform_real_distribution<double> car_x(-0.9, 0.9), car_y(-0.6, 0.8), car_z(19.6, 20.4);
+  std::vector<Point> street, car, copies;
+  while (street.size() < 150) {
+    const Eigen::Vector3d p(x(rng), y(rng), z(rng));
+    if (std::abs(p.x()) < 2.0 && p.z() > 15.0) continue;  // the car's lane ahead
+    if (!in_view(m.camera, p) || !in_view(m.camera, m.T_cam_world * p)) continue;
+    street.push_back({p, m.T_cam_world * p, random_descriptor(rng)});
+    if (street.size() % 2 == 0) copies.push_back({p + Eigen::Vector3d(4.0, 0.0, 0.0), p, flip(street.back().d, 4, rng)});
+  }
+  while (car.size() < 100) {
+    const Eigen::Vector3d p(car_x(rng), car_y(rng), car_z(rng));
+    car.push_back({p, p, random_descriptor(rng)});
+  }
+  std::vector<Point> mapped = street;
+  mapped.insert(mapped.end(), copies.begin(), copies.end());
+  mapped.insert(mapped.end(), car.begin(), car.end());
+  add_matched(m, mapped);
+  std::vector<Point> seen = street;
+  seen.insert(seen.end(), car.begin(), car.end());
+  add_current(m, seen, rng);
 }
 
 }  // namespace
 
 TEST_CASE("loop verification: two copies of a point are one match, copies metres apart are ambiguous") {
   SECTION("copies 2 cm apart (landmarks never fused): every point matched, the pose exact") {
-    CopiedMap m;
+    OneKeyframeMap m;
     build(m, Eigen::Vector3d(0.012, -0.01, 0.012));
     rgbl::LoopVerificationCounts counts;
     const auto v = rgbl::verify_loop(m.camera, m.current, m.map, m.matched, {}, &counts);
@@ -174,7 +147,7 @@ TEST_CASE("loop verification: two copies of a point are one match, copies metres
     CHECK(rgbl::rotation_angle(error.linear()) * 180.0 / M_PI < 0.1);
   }
   SECTION("copies 4 m apart along the street (a repeated facade): ambiguous, no loop") {
-    CopiedMap m;
+    OneKeyframeMap m;
     build(m, Eigen::Vector3d(4.0, 0.0, 0.0));
     rgbl::LoopVerificationCounts counts;
     const auto v = rgbl::verify_loop(m.camera, m.current, m.map, m.matched, {}, &counts);
@@ -218,7 +191,7 @@ TEST_CASE("loop verification measures the relative pose of two keyframes of one 
 }
 
 TEST_CASE("loop verification: a car that drove on with the camera outnumbers the street by descriptors, the street wins") {
-  CarAheadMap m;
+  OneKeyframeMap m;
   build_car_ahead(m);
   rgbl::LoopVerificationCounts counts;
   const auto v = rgbl::verify_loop(m.camera, m.current, m.map, m.matched, {}, &counts);

@@ -60,8 +60,12 @@ class LocalMapper {
   Map& map_;
   PinholeCamera camera_;
   LocalMappingOptions options_;
-  std::vector<LandmarkId> recent_landmarks_;
-  std::vector<LandmarkId> initial_landmarks_;  // of a map's first keyframe: the found-ratio rule only
+  // Landmarks under the culling rules until three keyframes after their first.
+  struct WatchedLandmark {
+    LandmarkId id;
+    bool initial = false;  // of a map's first keyframe: the found-ratio rule only
+  };
+  std::vector<WatchedLandmark> recent_landmarks_;
   std::atomic<bool> abort_{false};
 };
 
