@@ -300,8 +300,8 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
   // (or any object moving as one) is a rigid motion of its own, and where its points are in the map
   // (seen once and not culled) it can outnumber the street's among the descriptor matches. Each motion
   // with min_ransac_inliers is refined and searched; the one that explains more of the region wins.
-  // (04's revisit test with the ring plane fit: 86 matches on the car ahead against the street's
-  // fewer, the car's pose 5.3 m off with 109 guided inliers, the street's with 152, 2026-12-05.)
+  // (04's revisit test with the ring plane fit: 86 RANSAC inliers on the car ahead, its pose 5.3 m off
+  // with 109 inliers after the search; the street's motion, second, 76 and 152, 2026-12-05.)
   const FeatureGrid grid(current.keypoints, camera.width, camera.height);
   std::vector<bool> taken(matches.size(), false);
   std::optional<LoopVerification> best;
