@@ -147,7 +147,7 @@ TEST_CASE("lidar source on real frames: keypoint samples equal the dense map (di
   std::vector<Eigen::Vector2f> pixels;
   for (int y = 0; y < height; y += 3)
     for (int x = 0; x < width; x += 2) pixels.emplace_back(static_cast<float>(x) + 0.3F, static_cast<float>(y) - 0.4F);
-  // the rules as such: the surface mean without the ring plane fit (on by default, checked below)
+  // the rules as such: the surface mean without the ring plane fit (0.5 deg by default, checked below)
   auto sample = [&](rgbl::KeypointDepthRule rule, cv::Mat_<float>& dense, double fit_deg = 0.0) {
     rgbl::LidarSourceOptions options;
     options.keypoint_depth = rule;
@@ -187,7 +187,7 @@ TEST_CASE("lidar source on real frames: keypoint samples equal the dense map (di
   CHECK(changed > 0);
   CHECK(with_depth > pixels.size() / 5);
 
-  // The ring plane fit (LiDAR.SurfaceFitWindowDeg 0.5) moves only some keypoints (those on the road
+  // The ring plane fit (LiDAR.SurfaceFitWindowDeg 0.5, the default) moves only some keypoints (those on the road
   // between rings), never by more than its guard, 3 x the surface tolerance, from the surface mean.
   cv::Mat_<float> dense_fit;
   const auto fitted = sample(rgbl::KeypointDepthRule::surface_mean, dense_fit, 0.5);

@@ -19,8 +19,8 @@ struct DepthNoiseModel {
   // The scan's registration to the image is known to about this angle (LiDAR-camera calibration,
   // sync): a depth read where it changes by g metres per pixel is off by up to g times that many pixels.
   // Adds (registration_sigma_deg in px * gradient)^2, with the source's gradient (KeypointDepth; the
-  // LiDAR source's ring plane fit gives it on the road, so with the fit off, the default, nothing
-  // changes). 0.1 deg: both KITTI drives here track best with their scans turned 0.05-0.1 deg up
+  // LiDAR source's ring plane fit gives it on the road; with the fit off, LiDAR.SurfaceFitWindowDeg 0,
+  // nothing changes). 0.1 deg: both KITTI drives here track best with their scans turned 0.05-0.1 deg up
   // (calibrated on different days), and 04 tracks about equally well from 0.05 to 0.2 deg
   // (docs/accuracy.md, "Road depth weighted by its registration").
   double registration_sigma_deg = 0.1;

@@ -10,7 +10,7 @@
 //   LiDAR.Method, LiDAR.min_dist, LiDAR.max_dist, LiDAR.Tr11 .. LiDAR.Tr34 (T_cam_lidar, row-major),
 //   LiDAR.MethodInverseDilation.KernelType, LiDAR.MethodInverseDilation.KernelSize_u,
 //   rgbl's own LiDAR.OcclusionWindowDeg (0 = off), LiDAR.OcclusionRatio (LidarSourceOptions::occlusion_*),
-//   LiDAR.SurfaceFitWindowDeg (LidarSourceOptions::surface_fit_window_deg, 0 = off, the default),
+//   LiDAR.SurfaceFitWindowDeg (LidarSourceOptions::surface_fit_window_deg, 0 = off, default 0.5),
 //   LiDAR.RegistrationSigmaDeg (DepthNoiseModel::registration_sigma_deg, 0 = off, default 0.1),
 //   LiDAR.TimeOffset (SystemOptions::scan_time_offset: the image's time minus the scan's, seconds;
 //   overrides the dataset's scan timestamps, 0 = simultaneous),
@@ -83,7 +83,7 @@ struct Settings {
   int kernel_size = 0;                // 0 when absent
   std::optional<double> occlusion_window_deg;  // LiDAR.OcclusionWindowDeg; unset = the source's default
   std::optional<double> occlusion_ratio;       // LiDAR.OcclusionRatio; unset = the source's default
-  std::optional<double> surface_fit_window_deg;  // LiDAR.SurfaceFitWindowDeg; unset = the source's default (0, off)
+  std::optional<double> surface_fit_window_deg;  // LiDAR.SurfaceFitWindowDeg; unset = the source's default (0.5)
   std::optional<double> registration_sigma_deg;  // LiDAR.RegistrationSigmaDeg; unset = the model's default
   std::optional<double> scan_time_offset;      // LiDAR.TimeOffset, s; unset = the dataset's scan timestamps
   LoopClosingSettings loop_closing;
