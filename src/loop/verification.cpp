@@ -280,6 +280,7 @@ void LoopVerificationOptions::validate() const {
   require(min_inliers >= 3, "loop_verification.min_inliers", ">= 3");
   require(guided_radius_px > 0.0, "loop_verification.guided_radius_px", "> 0 px");
   require(min_inlier_ratio >= 0.0 && min_inlier_ratio <= 1.0, "loop_verification.min_inlier_ratio", "in [0, 1]");
+  require(max_motions >= 1, "loop_verification.max_motions", ">= 1");
 }
 
 std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const Keyframe& current, const Map& map,
@@ -296,17 +297,18 @@ std::optional<LoopVerification> verify_loop(const PinholeCamera& camera, const K
   reached.matches = static_cast<int>(matches.size());
   if (reached.matches < options.min_ransac_inliers) return std::nullopt;
 
-  // The best rigid motion of the matches, then the best of those it leaves out: a car driving ahead
-  // (or any object moving as one) is a rigid motion of its own, and where its points are in the map
-  // (seen once and not culled) it can outnumber the street's among the descriptor matches. Each motion
-  // with min_ransac_inliers is refined and searched; the one that explains more of the region wins.
-  // (04's revisit test with the ring plane fit: 86 RANSAC inliers on the car ahead, its pose 5.3 m off
-  // with 109 inliers after the search; the street's motion, second, 76 and 152, 2026-12-05.)
+  // The best rigid motion of the matches, then the best of those it leaves out, up to max_motions: a
+  // car driving ahead (or any object moving as one) is a rigid motion of its own, and where its points
+  // are in the map (seen once and not culled) it can outnumber the street's among the descriptor
+  // matches. Each motion with min_ransac_inliers is refined and searched; the one that explains most
+  // of the region wins. (04's revisit test with the ring plane fit and without the first keyframe's
+  // culling: 86 RANSAC inliers on the car ahead, its pose 5.3 m off with 109 inliers after the search;
+  // the street's motion, second, 76 and 152, 2026-12-05.)
   const FeatureGrid grid(current.keypoints, camera.width, camera.height);
   std::vector<bool> taken(matches.size(), false);
   std::optional<LoopVerification> best;
   LoopVerificationCounts best_counts;
-  for (int motion = 0; motion < 2; ++motion) {
+  for (int motion = 0; motion < options.max_motions; ++motion) {
     std::vector<PointMatch> rest;
     std::vector<std::size_t> index_of_rest;  // into matches
     for (std::size_t i = 0; i < matches.size(); ++i) {

@@ -104,8 +104,9 @@ void build(OneKeyframeMap& m, const Eigen::Vector3d& offset) {
 // 150 street points, half of them with a copy 4 m along the street (a repeated facade: their
 // descriptor matches are ambiguous and dropped), and 100 points on a car 20 m ahead. The current
 // keyframe is 5 m further on and sees the street where it is and the car again 20 m ahead (it drove
-// on with the camera): by descriptors the car outnumbers the street, 100 to 90.
-void build_car_ahead(OneKeyframeMap& m) {
+// on with the camera): by descriptors the car outnumbers the street, 100 to 90. With second_car, 95
+// more points on a car in the right lane that drove on at half the camera's speed.
+void build_car_ahead(OneKeyframeMap& m, bool second_car = false) {
   m.T_cam_world.translation() = Eigen::Vector3d(0.0, 0.0, -5.0);
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> x(-12.0, 12.0), y(-3.0, 1.5), z(8.0, 30.0);
@@ -122,6 +123,13 @@ void build_car_ahead(OneKeyframeMap& m) {
     const Eigen::Vector3d p(car_x(rng), car_y(rng), car_z(rng));
     car.push_back({p, p, random_descriptor(rng)});
   }
+  // the second car, in the right lane 12-14 m ahead, drove on 2.5 m while the camera drove 5 m: seen
+  // 2.5 m nearer, a motion of its own (2.5 m from the truth's and from the first car's)
+  std::uniform_real_distribution<double> right_x(3.0, 4.6), right_z(12.0, 14.0);
+  while (second_car && car.size() < 195) {
+    const Eigen::Vector3d p(right_x(rng), car_y(rng), right_z(rng));
+    car.push_back({p, p + Eigen::Vector3d(0.0, 0.0, -2.5), random_descriptor(rng)});
+  }
   std::vector<Point> mapped = street;
   mapped.insert(mapped.end(), copies.begin(), copies.end());
   mapped.insert(mapped.end(), car.begin(), car.end());
@@ -129,6 +137,19 @@ void build_car_ahead(OneKeyframeMap& m) {
   std::vector<Point> seen = street;
   seen.insert(seen.end(), car.begin(), car.end());
   add_current(m, seen, rng);
+}
+
+// The street's motion wins: the verified pose is the truth's, on the street's 150 inliers (a car's
+// motion has at most 100).
+void check_street_wins(const OneKeyframeMap& m) {
+  rgbl::LoopVerificationCounts counts;
+  const auto v = rgbl::verify_loop(m.camera, m.current, m.map, m.matched, {}, &counts);
+  CAPTURE(counts.matches, counts.ransac_inliers, counts.guided_matches, counts.inliers);
+  REQUIRE(v.has_value());
+  const Eigen::Isometry3d error = m.T_cam_world.inverse() * v->T_cam_world;
+  CHECK(error.translation().norm() < 0.05);
+  CHECK(rgbl::rotation_angle(error.linear()) * 180.0 / M_PI < 0.1);
+  CHECK(counts.inliers >= 140);
 }
 
 }  // namespace
@@ -193,16 +214,22 @@ TEST_CASE("loop verification measures the relative pose of two keyframes of one 
 TEST_CASE("loop verification: a car that drove on with the camera outnumbers the street by descriptors, the street wins") {
   OneKeyframeMap m;
   build_car_ahead(m);
-  rgbl::LoopVerificationCounts counts;
-  const auto v = rgbl::verify_loop(m.camera, m.current, m.map, m.matched, {}, &counts);
-  CAPTURE(counts.matches, counts.ransac_inliers, counts.guided_matches, counts.inliers);
-  REQUIRE(v.has_value());
   // the car's motion is RANSAC's best (its pose is the map keyframe's, 5 m off); the street's, found
   // among the matches it leaves, explains more of the region once searched from its pose
-  const Eigen::Isometry3d error = m.T_cam_world.inverse() * v->T_cam_world;
-  CHECK(error.translation().norm() < 0.05);
-  CHECK(rgbl::rotation_angle(error.linear()) * 180.0 / M_PI < 0.1);
-  CHECK(counts.inliers >= 140);  // the street's 150, not the car's 100
+  check_street_wins(m);
+}
+
+TEST_CASE("loop verification: two cars that drove on each outnumber the street by descriptors, the street wins") {
+  OneKeyframeMap m;
+  build_car_ahead(m, true);
+  // RANSAC finds the first car's motion (100 matches), then the second's (95), then the street's (87)
+  check_street_wins(m);
+  // weighing two motions only, the first car wins: its pose is the map keyframe's, 5 m off
+  rgbl::LoopVerificationOptions two;
+  two.max_motions = 2;
+  const auto wrong = rgbl::verify_loop(m.camera, m.current, m.map, m.matched, two);
+  REQUIRE(wrong.has_value());
+  CHECK((m.T_cam_world.inverse() * wrong->T_cam_world).translation().norm() > 2.0);
 }
 
 TEST_CASE("loop verification rejects every keyframe of another drive") {
@@ -252,6 +279,9 @@ TEST_CASE("loop verification options are checked, naming the field") {
   o = {};
   o.min_inliers = 2;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_verification.min_inliers"));
+  o = {};
+  o.max_motions = 0;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("loop_verification.max_motions"));
   // a keyframe whose arrays disagree is refused before anything is indexed
   rgbl::Map map;
   rgbl::Keyframe k;

@@ -2,9 +2,9 @@
 // Geometric verification of a loop candidate with metric depth: the current keyframe's keypoints that
 // have depth (3-D points in its camera) are matched by descriptor to the landmarks of the candidate
 // keyframe and its best covisible neighbours (3-D points in the map), a 3-point RANSAC finds the rigid
-// motion that aligns them (SE(3): depth is metric, no scale; then once more among the matches it leaves
-// out, since a car driving on with the camera is a rigid motion too, and the motion that explains more
-// of the region after the steps below wins), the pose of the current keyframe in the
+// motion that aligns them (SE(3): depth is metric, no scale; then again among the matches each motion
+// leaves out, up to max_motions, since a car driving on with the camera is a rigid motion too, and the
+// motion that explains most of the region after the steps below wins), the pose of the current keyframe in the
 // candidate's map is refined on that consensus, every region landmark is searched near where that pose
 // projects it (guided search), and the pose is refined again on reprojection and depth of all the
 // guided matches. A loop is the relative pose between the two keyframes; it is only a loop when enough
@@ -36,6 +36,11 @@ struct LoopVerificationOptions {
   // verify_loop_guided: landmarks are searched this far from where the guess projects them, times the
   // scale of the pyramid level their distance predicts (ORB-SLAM's projection searches use 7.5-15 px).
   double guided_radius_px = 10.0;
+  // Rigid motions weighed: RANSAC's best, then the best of the matches each leaves out, while one
+  // finds min_ransac_inliers. A car driving on with the camera is a motion of its own, and two cars can
+  // each outnumber the street among the descriptor matches; the motion that explains most of the
+  // region once searched wins.
+  int max_motions = 3;
 
   void validate() const;
 };
