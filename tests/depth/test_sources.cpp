@@ -187,8 +187,8 @@ TEST_CASE("lidar source on real frames: keypoint samples equal the dense map (di
   CHECK(changed > 0);
   CHECK(with_depth > pixels.size() / 5);
 
-  // The ring plane fit (LiDAR.SurfaceFitWindowDeg 0.5, the default) moves only some keypoints (those on the road
-  // between rings), never by more than its guard, 3 x the surface tolerance, from the surface mean.
+  // The ring plane fit (LiDAR.SurfaceFitWindowDeg 0.5, the default) moves only some keypoints (those on
+  // the road between rings), never by more than its guard, 3 x the surface tolerance, from the surface mean.
   cv::Mat_<float> dense_fit;
   const auto fitted = sample(rgbl::KeypointDepthRule::surface_mean, dense_fit, 0.5);
   std::size_t moved = 0;

@@ -413,8 +413,8 @@ TEST_CASE("map merging: the new map after a jump is bridged to the old one by re
   const double worst_before = *std::max_element(bridged.error.begin(), bridged.error.begin() + 60);
   fmt::print("a jump on the first lap bridged at frame {}: error there {:.3f} m (without merging {:.3f} m), at most "
              "{:.3f} m to the end (at most {:.3f} m before the gap); ATE {:.3f} m, without merging {:.3f} m\n",
-             fed[*bridge_at], bridged.error[*bridge_at], apart.error[*bridge_at], worst_after, worst_before, bridged.ate,
-             apart.ate);
+             fed[*bridge_at], bridged.error[*bridge_at], apart.error[*bridge_at], worst_after, worst_before,
+             bridged.ate, apart.ate);
   // measured: see docs/loop-closing.md (bridging a gap)
   CHECK(bridged.error[*bridge_at] < 0.2);
   CHECK(apart.error[*bridge_at] > 0.5);

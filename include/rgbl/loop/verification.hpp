@@ -4,10 +4,10 @@
 // keyframe and its best covisible neighbours (3-D points in the map), a 3-point RANSAC finds the rigid
 // motion that aligns them (SE(3): depth is metric, no scale; then again among the matches each motion
 // leaves out, up to max_motions, since a car driving on with the camera is a rigid motion too, and the
-// motion that explains most of the region after the steps below wins), the pose of the current keyframe in the
-// candidate's map is refined on that consensus, every region landmark is searched near where that pose
-// projects it (guided search), and the pose is refined again on reprojection and depth of all the
-// guided matches. A loop is the relative pose between the two keyframes; it is only a loop when enough
+// motion that explains most of the region after the steps below wins), the pose of the current
+// keyframe in the candidate's map is refined on that consensus, every region landmark is searched near
+// where that pose projects it (guided search), and the pose is refined again on reprojection and depth
+// of all the guided matches. A loop is the relative pose between the two keyframes; it is only a loop when enough
 // matches agree, and a false loop is worse than none, so every threshold errs on the side of rejecting.
 
 #include "rgbl/backend/loop_correction.hpp"
