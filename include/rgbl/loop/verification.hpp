@@ -7,8 +7,9 @@
 // motion that explains most of the region after the steps below wins), the pose of the current
 // keyframe in the candidate's map is refined on that consensus, every region landmark is searched near
 // where that pose projects it (guided search), and the pose is refined again on reprojection and depth
-// of all the guided matches. A loop is the relative pose between the two keyframes; it is only a loop when enough
-// matches agree, and a false loop is worse than none, so every threshold errs on the side of rejecting.
+// of all the guided matches. A loop is the relative pose between the two keyframes; it is only a loop
+// when enough matches agree, and a false loop is worse than none, so every threshold errs on the side
+// of rejecting.
 
 #include "rgbl/backend/loop_correction.hpp"
 #include "rgbl/geometry/camera.hpp"
