@@ -254,11 +254,6 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
     const ScanSample coarse = voxel_downsample(query, options, options.search_voxel);
     ScanRegistrationOptions search = options;
     search.max_iterations = options.search_iterations;
-    // The search finds basins, on voxel means search_voxel apart: the coarse gate throughout. With the
-    // fine gate after coarse_iterations a start's correspondences could halve at the switch and drop it
-    // under min_correspondences (traffic seed 3's frame 40 after a 1 s gap: one start of 33 kept
-    // exactly the 69 needed, the others fewer; the refinement below still ends on the fine gate).
-    search.coarse_iterations = options.search_iterations;
     search.min_correspondences = std::max<std::size_t>(
         6, options.min_correspondences * coarse.points.size() / std::max<std::size_t>(1, query_points.points.size()));
     std::vector<std::pair<double, Eigen::Isometry3d>> found;  // share of the coarse points landing, pose

@@ -55,9 +55,9 @@ struct ScanRegistrationOptions {
   double along_range_m = 0.0;
   double along_step_m = 2.0;
   // The search runs ICP from every start on a coarser query (one point per search_voxel) for
-  // search_iterations, all within coarse_distance, ranks the results by the share of those points that
-  // land, and refines the refine_best best that are distinct (more than probe_shift_m or half a yaw step
-  // apart) on the full query; of those that converge, the one where most points land wins.
+  // search_iterations, ranks the results by the share of those points that land, and refines the
+  // refine_best best that are distinct (more than probe_shift_m or half a yaw step apart) on the full
+  // query; of those that converge, the one where most points land wins.
   double search_voxel = 2.0;  // m
   int search_iterations = 10;
   std::size_t refine_best = 3;
