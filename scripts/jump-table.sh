@@ -9,6 +9,7 @@
 #                         [--settings FILE]   (a settings YAML for every run, e.g. to switch an option off)
 #
 # Data: $RGBL_DATA, else ../shared/data next to the repository; scenarios cached as scripts/accuracy.sh does.
+# Two tables compared pair by pair, every column: scripts/jump_compare.py A B.
 set -euo pipefail
 
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -30,7 +31,7 @@ while [ $# -gt 0 ]; do
     --no-real) real=0; shift ;;
     --no-sim) sim=0; shift ;;
     --settings) settings=(--settings "$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"); shift 2 ;;
-    -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
     *) echo "jump-table.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
