@@ -57,7 +57,7 @@ TEST_CASE("loop closer: a revisit of real keyframes with drift is closed and cor
   const rgbl::test::Mapped m = rgbl::test::map_drive(sequence, 30, no_loops);
   // the car ahead in frame 0 leaves nothing a revisit could be aligned to
   const int unfound = rgbl::test::unfound_first_keyframe_landmarks(m.system->map(), no_loops.mapping.min_found_ratio);
-  CAPTURE(unfound);  // measured: 9 inline after 30 frames, 6 threaded after 20 (341 and 339 before)
+  CAPTURE(unfound);  // measured: 9 after 30 frames (341 before)
   CHECK(unfound <= 30);
   rgbl::Map map;
   copy_map(m.system->map(), map);

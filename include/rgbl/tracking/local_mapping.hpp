@@ -40,10 +40,10 @@ class LocalMapper {
   // A map's first keyframe is made by tracking's initialisation, not by process(): its landmarks are
   // put under the found-ratio rule of every later keyframe's, checked as the next three keyframes are
   // mapped. Without it a point on a car driving ahead in the first frame, predicted visible in a dozen
-  // frames and found in no frame after its own, stays in the map for good, and a loop verification can align a revisit to that car rather
-  // than to the street (2026-12-05). The min_observations rule is left out: it also takes the points
-  // the return of a loop to the drive's start needs (the simulator's loop tests lose their closures).
-  // Takes the map lock itself.
+  // frames and found in no frame after its own, stays in the map for good, and a loop verification can
+  // align a revisit to that car rather than to the street (2026-12-05). The min_observations rule is
+  // left out: it also takes the points the return of a loop to the drive's start needs (the
+  // simulator's loop tests lose their closures). Takes the map lock itself.
   void watch_initial(KeyframeId keyframe);
 
   // Asks a running bundle adjustment to stop early (e.g. when a new keyframe is waiting).
