@@ -6,7 +6,11 @@
 #
 #   scripts/accuracy.sh [--build DIR] [--out DIR] [--seeds "1 2 3"] [--frames N] [--scenarios "a b"]
 #                       [--baseline FILE | --no-baseline] [--save-baseline FILE] [--no-real] [--no-variants] [--no-sim]
-#                       [-- ARGS for rgbl run, e.g. --threaded --realtime]
+#                       [--exact-depth] [-- ARGS for rgbl run, e.g. --threaded --realtime]
+#
+# --exact-depth: the scenarios only, each tracked on the simulator's exact depth images instead of its
+# LiDAR (`--depth precomputed:<street>/depth`); set against the default table, it tells how much of a
+# scenario's error the LiDAR's depth carries (compare with --no-baseline: the baseline is the LiDAR's).
 #
 # Each scenario runs at its default length (`rgbl demo --scenario list`) unless --frames is given; the
 # plain street runs at every length used (`plain@<frames>-s<seed>`), so each scenario's ATE is compared
@@ -33,6 +37,7 @@ save=""
 real=1
 variants=1
 sim=1
+exact=""
 extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -47,8 +52,9 @@ while [ $# -gt 0 ]; do
     --no-real) real=0; shift ;;
     --no-variants) variants=0; shift ;;
     --no-sim) sim=0; shift ;;
+    --exact-depth) exact=exact; real=0; shift ;;
     --) shift; extra=("$@"); break ;;
-    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
+    -h|--help) awk 'NR > 1 && !/^#/ { exit } NR > 1' "$0"; exit 0 ;;
     *) echo "accuracy.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -75,6 +81,7 @@ track() {  # name, then rgbl arguments
   fi
 }
 
+[ -n "$exact" ] && echo "exact depth: the scenarios on the simulator's depth images, no real drives"
 if [ "$real" = 1 ]; then
   if [ -d "$data/kitti" ]; then
     echo "real excerpts in $data/kitti:"
@@ -149,9 +156,11 @@ if [ "$sim" = 1 ]; then
   for run in "${runs[@]}"; do
     read -r name s n <<< "$run"
     for seed in $seeds; do
-      dataset="$(scenario_dataset "$rgbl" "$cache" "$key" "$s" "$seed" "$n" "$log")" \
+      dataset="$(scenario_dataset "$rgbl" "$cache" "$key" "$s" "$seed" "$n" "$log" "$exact")" \
         || { printf '  %-28s generation FAILED\n' "$name-s$seed"; continue; }
-      track "$name-s$seed" run "$dataset" "${extra[@]}"
+      depth=()
+      [ -n "$exact" ] && depth=(--depth "precomputed:$dataset/depth")
+      track "$name-s$seed" run "$dataset" "${depth[@]}" "${extra[@]}"
     done
   done
 fi
