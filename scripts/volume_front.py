@@ -6,6 +6,7 @@ depth (docs/accuracy.md, "Seeds never looked at, and the LiDAR's share of each s
   PYTHONPATH=build/release/python scripts/volume_front.py window SEQ [--frames A B] [--deg D] [--gate K] [--band F]
   PYTHONPATH=build/release/python scripts/volume_front.py landmark SEQ [--span N] [--radius R] [--allow S]
   PYTHONPATH=build/release/python scripts/volume_front.py kernel SEQ [--span N]
+  scripts/volume_front.py map SEQ --run RUN [--run RUN2 ...]
 
 SEQ: a street rendered with its exact depth images (sequences/00 of `rgbl demo --depth precomputed
 --keep DIR`, or a street in the accuracy suite's cache, ~/.cache/rgbl/scenarios/<name>/sequences/00).
@@ -28,6 +29,11 @@ poses make this an upper bound of what a tracker's own poses would give.
 next N frames; at each, the library's surface mean and the kernel's minimum (`lidar:dilated`). Prints
 the median gap between the two per landmark, biased against clean: whether the kernel's minimum,
 taken over frames, marks a front.
+
+`map`: how deep a run's map reads the hedge. The landmarks of RUN's map.ply (an `rgbl run --out` folder
+of SEQ), seen from the run's own pose of every 10th frame, against the exact depth at their pixels
+(within 5 %): the median and mean relative error nearer than 10 m on the right (x >= 300 px) and
+elsewhere.
 
 Needs python3-numpy, python3-opencv, python3-scipy and the Python module.
 """
@@ -231,9 +237,38 @@ def kernel_rule(street, span):
         print(f'  {name:18s} n={m.sum():5d}  surface mean - kernel minimum q10/50/90 {np.round(np.percentile(a[m, 1], [10, 50, 90]), 3)} m')
 
 
+def map_check(street, runs):
+    for run in runs:
+        lines = open(os.path.join(run, 'map.ply')).read().split('\n')
+        n = int(next(line for line in lines if line.startswith('element vertex')).split()[-1])
+        start = lines.index('end_header') + 1
+        X = np.array([[float(v) for v in lines[start + i].split()[:3]] for i in range(n)])
+        estimate = np.loadtxt(os.path.join(run, 'trajectory_kitti.txt')).reshape(-1, 3, 4)
+        views = []
+        for K in range(10, len(street.frames) - 5, 10):
+            T_world_cam = np.vstack([estimate[K], [0, 0, 0, 1]])
+            p = (np.linalg.inv(T_world_cam) @ np.c_[X, np.ones(n)].T).T[:, :3]
+            exact = street.exact(K)
+            for x, y, z in p:
+                if not 1 < z < 30:
+                    continue
+                u = int(round(street.fx * x / z + street.cx))
+                v = int(round(street.fy * y / z + street.cy))
+                if not (0 <= u < exact.shape[1] and 0 <= v < exact.shape[0]):
+                    continue
+                t = exact[v, u]
+                if t > 0 and abs(z / t - 1) <= 0.05:
+                    views.append((u, t, z / t - 1))
+        a = np.array(views)
+        hedge = (a[:, 0] >= 300) & (a[:, 1] < 10)
+        print(f'{run}: {len(a)} landmark views; hedge median {100 * np.median(a[hedge, 2]):+.2f} % mean '
+              f'{100 * a[hedge, 2].mean():+.2f} % ({hedge.sum()}); elsewhere median {100 * np.median(a[~hedge, 2]):+.2f} % '
+              f'mean {100 * a[~hedge, 2].mean():+.2f} %')
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument('mode', choices=('window', 'landmark', 'kernel'))
+    parser.add_argument('mode', choices=('window', 'landmark', 'kernel', 'map'))
     parser.add_argument('seq')
     parser.add_argument('--frames', nargs=2, type=int, default=(0, 10))
     parser.add_argument('--deg', type=float, default=1.0)
@@ -242,10 +277,13 @@ def main():
     parser.add_argument('--span', type=int, default=20)
     parser.add_argument('--radius', type=float, default=0.4)
     parser.add_argument('--allow', type=float, default=0.0)
+    parser.add_argument('--run', action='append', default=[])
     args = parser.parse_args()
     street = Street(args.seq)
     if args.mode == 'window':
         window_rule(street, args.frames[0], args.frames[1], args.deg, args.gate, args.band)
+    elif args.mode == 'map':
+        map_check(street, args.run)
     elif args.mode == 'landmark':
         landmark_rule(street, args.span, args.radius, args.allow)
     else:
