@@ -33,7 +33,7 @@ taken over frames, marks a front.
 `map`: how deep a run's map reads the hedge. The landmarks of RUN's map.ply (an `rgbl run --out` folder
 of SEQ), seen from the run's own pose of every 10th frame, against the exact depth at their pixels
 (within 5 %): the median and mean relative error nearer than 10 m on the right (x >= 300 px) and
-elsewhere.
+elsewhere, then by image third, below the camera and by distance.
 
 Needs python3-numpy, python3-opencv, python3-scipy and the Python module.
 """
@@ -258,12 +258,20 @@ def map_check(street, runs):
                     continue
                 t = exact[v, u]
                 if t > 0 and abs(z / t - 1) <= 0.05:
-                    views.append((u, t, z / t - 1))
+                    views.append((u, t, z / t - 1, y))
         a = np.array(views)
         hedge = (a[:, 0] >= 300) & (a[:, 1] < 10)
         print(f'{run}: {len(a)} landmark views; hedge median {100 * np.median(a[hedge, 2]):+.2f} % mean '
               f'{100 * a[hedge, 2].mean():+.2f} % ({hedge.sum()}); elsewhere median {100 * np.median(a[~hedge, 2]):+.2f} % '
               f'mean {100 * a[~hedge, 2].mean():+.2f} %')
+        third = street.shape[1] / 3
+        for name, m in (('left third', a[:, 0] < third), ('middle third', (a[:, 0] >= third) & (a[:, 0] < 2 * third)),
+                        ('right third', a[:, 0] >= 2 * third), ('over 1.2 m below the camera', a[:, 3] > 1.2),
+                        ('nearer than 10 m', a[:, 1] < 10), ('10-20 m', (a[:, 1] >= 10) & (a[:, 1] < 20)),
+                        ('20 m and more', a[:, 1] >= 20)):
+            if m.sum() >= 5:
+                print(f'  {name:28s} {m.sum():5d} views, median {100 * np.median(a[m, 2]):+.2f} %, '
+                      f'share of the summed error {100 * a[m, 2].sum() / a[:, 2].sum():4.0f} %')
 
 
 def main():
