@@ -7,6 +7,7 @@ depth (docs/accuracy.md, "Seeds never looked at, and the LiDAR's share of each s
   PYTHONPATH=build/release/python scripts/volume_front.py landmark SEQ [--span N] [--radius R] [--allow S]
   PYTHONPATH=build/release/python scripts/volume_front.py kernel SEQ [--span N]
   scripts/volume_front.py map SEQ --run RUN [--run RUN2 ...]
+  PYTHONPATH=build/release/python scripts/volume_front.py road SEQ
 
 SEQ: a street rendered with its exact depth images (sequences/00 of `rgbl demo --depth precomputed
 --keep DIR`, or a street in the accuracy suite's cache, ~/.cache/rgbl/scenarios/<name>/sequences/00).
@@ -34,6 +35,10 @@ taken over frames, marks a front.
 of SEQ), seen from the run's own pose of every 10th frame, against the exact depth at their pixels
 (within 5 %): the median and mean relative error nearer than 10 m on the right (x >= 300 px) and
 elsewhere, then by image third, below the camera and by distance.
+
+`road`: the library's `lidar` source on the road ahead, frame by frame: the median relative depth
+error of the keypoints in the image's middle third more than 1.2 m below the camera (every 5th frame),
+with the ring fit (0.5 deg) and without. Tells a source's bias from a map read from drifted poses.
 
 Needs python3-numpy, python3-opencv, python3-scipy and the Python module.
 """
@@ -274,9 +279,39 @@ def map_check(street, runs):
                       f'share of the summed error {100 * a[m, 2].sum() / a[:, 2].sum():4.0f} %')
 
 
+def road_check(street):
+    sources = (rgbl.make_lidar_source(street.calibration, surface_fit_window_deg=0.5),
+               rgbl.make_lidar_source(street.calibration, surface_fit_window_deg=0.0))
+    orb = cv2.ORB_create(2000)
+    h, w = street.shape
+    medians = []
+    for t in range(0, len(street.frames), 5):
+        image, raw, exact = street.image(t), street.raw(t), street.exact(t)
+        pixels = np.array([k.pt for k in orb.detect(image, None)], np.float32).reshape(-1, 2)
+        samples = []
+        for source in sources:
+            source.prepare(image, raw)
+            samples.append(np.asarray(source.sample(pixels)))
+        errors = []
+        for (u, v), fitted, plain in zip(pixels, samples[0], samples[1]):
+            true_z = exact[int(np.floor(v + .5)), int(np.floor(u + .5))]
+            if not (true_z > 0 and fitted[0] > 0 and plain[0] > 0) or fitted[2] > max(1.0, 0.05 * fitted[0]):
+                continue
+            below = (v - street.cy) * true_z / street.fy
+            if below > 1.2 and w / 3 <= u < 2 * w / 3 and abs(fitted[0] / true_z - 1) < 0.2:
+                errors.append((fitted[0] / true_z - 1, plain[0] / true_z - 1))
+        if errors:
+            e = np.array(errors)
+            medians.append((t, np.median(e[:, 0]), np.median(e[:, 1])))
+    m = np.array(medians)
+    print(f'{street.seq}: road ahead, median per frame (fit / none): '
+          + ' '.join(f'{int(t)}:{100 * a:+.2f}/{100 * b:+.2f}' for t, a, b in m))
+    print(f'  median over the frames: {100 * np.median(m[:, 1]):+.3f} % with the fit, {100 * np.median(m[:, 2]):+.3f} % without')
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument('mode', choices=('window', 'landmark', 'kernel', 'map'))
+    parser.add_argument('mode', choices=('window', 'landmark', 'kernel', 'map', 'road'))
     parser.add_argument('seq')
     parser.add_argument('--frames', nargs=2, type=int, default=(0, 10))
     parser.add_argument('--deg', type=float, default=1.0)
@@ -290,6 +325,8 @@ def main():
     street = Street(args.seq)
     if args.mode == 'window':
         window_rule(street, args.frames[0], args.frames[1], args.deg, args.gate, args.band)
+    elif args.mode == 'road':
+        road_check(street)
     elif args.mode == 'map':
         map_check(street, args.run)
     elif args.mode == 'landmark':
