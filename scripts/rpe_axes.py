@@ -8,7 +8,8 @@ For each pair of consecutive frames, E = (T_gt_i^-1 T_gt_i+1)^-1 (T_est_i^-1 T_e
 (bias) and RMS (jitter) of E's rotation about x (pitch), y (yaw), z (roll) in degrees and of its
 translation in metres (x right, y down, z forward); then the five steps with the largest translation
 error, and the ATE by axis after a rigid (SE(3)) alignment, in the first frame's axes (and the ATE
-after a similarity alignment, with its scale). Given a run
+after a similarity alignment, with its scale), and the path's length against the truth's, in all and
+per 20 frames. Given a run
 folder with timing.csv, also the same rotation error between consecutive keyframes (the frames made
 keyframes, at their written poses). Needs python3-numpy.
 """
@@ -90,6 +91,12 @@ def main():
     scale = (S * np.diag(D)).sum() / ((p_est - mu_est) ** 2).sum()
     err = scale * (p_est - mu_est) @ R.T + mu_gt - p_gt
     print(f"  with a scale {scale:.4f}: {np.sqrt((err ** 2).sum(axis=1).mean()):.4f}")
+    # the path's length against the truth's, in all and per 20 steps: where a scale error is made
+    step_est = np.linalg.norm(np.diff(p_est, axis=0), axis=1)
+    step_gt = np.linalg.norm(np.diff(p_gt, axis=0), axis=1)
+    print(f"path / truth {step_est.sum() / step_gt.sum():.4f}; per 20 frames: " + ", ".join(
+        f"{a}-{min(a + 20, n - 1)} {100 * (step_est[a:a + 20].sum() / step_gt[a:a + 20].sum() - 1):+.2f} %"
+        for a in range(0, n - 1, 20)))
 
 
 if __name__ == "__main__":

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Does a real drive's vegetation read deep in the LiDAR? The library's `lidar` source at ORB keypoints
-of camera 0 against stereo block matching with camera 1 (9x9 ZNCC >= 0.9 along the row within 0.7-1.4x
-of the LiDAR's disparity, unique by 0.05, parabola sub-pixel), split by distance and by colour: a
-keypoint is green where camera 2's image at its stereo point has excess green (2g - r - b) / (r + g + b)
-above 0.06 (docs/accuracy.md, "Seeds never looked at", real vegetation).
+of camera 0 against its `stereo_sparse` source (ORB-SLAM's row search with camera 1: SAD window,
+uniqueness test, parabola sub-pixel; include/rgbl/depth/sources.hpp) at the same pixels, split by
+distance and by colour: a keypoint is green where camera 2's image at its stereo point has excess
+green (2g - r - b) / (r + g + b) above 0.06 (docs/accuracy.md, "Seeds never looked at", real vegetation).
 
   PYTHONPATH=build/release/python scripts/stereo_vs_lidar.py SEQ [STEP] [FIT_DEG]
 
@@ -12,6 +12,7 @@ raw_extended, which holds camera 0 only); every STEP-th frame (default 2); FIT_D
 (default 0.5, the library's default). Needs python3-numpy, python3-opencv and the Python module.
 """
 import sys
+
 import cv2
 import numpy as np
 import rgbl
@@ -21,71 +22,49 @@ step = int(sys.argv[2]) if len(sys.argv) > 2 else 2
 fit = float(sys.argv[3]) if len(sys.argv) > 3 else 0.5
 seq = rgbl.open_sequence(seq_path)
 cal = seq.calibration
-P0 = np.asarray(cal.P[0]); P1 = np.asarray(cal.P[1]); P2 = np.asarray(cal.P[2])
-f = P0[0, 0]; cx = P0[0, 2]; cy = P0[1, 2]
-fb = -(P1[0, 3] - P0[0, 3])
-src = rgbl.make_lidar_source(cal.camera(0), surface_fit_window_deg=fit)
+camera = cal.camera(0)
+P2 = np.asarray(cal.P[2])
+lidar = rgbl.make_lidar_source(camera, surface_fit_window_deg=fit)
+stereo = rgbl.make_depth_source('stereo_sparse', camera, stereo_baseline=cal.baseline(0, 1))
 orb = cv2.ORB_create(2000)
-H = 4  # half patch
-rows = []
+rows = []  # lidar z, stereo z, excess green
 for i in range(0, len(seq), step):
     fr = seq.load(i)
-    L, R, C = fr.images[0], fr.images[1], fr.images[2]
-    if L.ndim == 3: L = cv2.cvtColor(L, cv2.COLOR_BGR2GRAY)
-    if R.ndim == 3: R = cv2.cvtColor(R, cv2.COLOR_BGR2GRAY)
-    kps = orb.detect(L, None)
-    pix = np.array([[np.floor(k.pt[0] + 0.5), np.floor(k.pt[1] + 0.5)] for k in kps], np.float32)
-    src.prepare(L, fr.scan)
-    s = np.asarray(src.sample(pix))
-    Lf = L.astype(np.float32); Rf = R.astype(np.float32)
-    h, w = L.shape
-    for (x, y), (dl, dist, spread, grad) in zip(pix.astype(int), s):
-        if not (3.0 < dl < 40.0) or y < H or y >= h - H or x < H + 1 or x >= w - H:
+    left, right, colour = fr.images[0], fr.images[1], fr.images[2]
+    if left.ndim == 3: left = cv2.cvtColor(left, cv2.COLOR_BGR2GRAY)
+    if right.ndim == 3: right = cv2.cvtColor(right, cv2.COLOR_BGR2GRAY)
+    pixels = np.array([k.pt for k in orb.detect(left, None)], np.float32).reshape(-1, 2)
+    lidar.prepare(left, fr.scan)
+    stereo.prepare(left, image_right=right)
+    for (u, v), (zl, _, spread, _), (zs, _, _, _) in zip(pixels, np.asarray(lidar.sample(pixels)),
+                                                         np.asarray(stereo.sample(pixels))):
+        if not (3.0 < zl < 40.0) or spread > max(1.0, 0.05 * zl) or not zs > 0:
             continue
-        d0 = fb / dl
-        lo = max(1, int(np.floor(min(0.7 * d0, d0 - 3)))); hi = int(np.ceil(max(1.4 * d0, d0 + 3)))
-        if x - hi - H < 0:
+        # the colour of the stereo point in camera 2
+        X = np.array([*camera.camera.unproject((float(u), float(v)), float(zs)), 1.0])
+        u2 = P2 @ X
+        x2, y2 = int(round(u2[0] / u2[2])), int(round(u2[1] / u2[2]))
+        if not (2 <= x2 < colour.shape[1] - 2 and 2 <= y2 < colour.shape[0] - 2):
             continue
-        a = Lf[y - H:y + H + 1, x - H:x + H + 1].ravel(); a = a - a.mean(); na = np.linalg.norm(a)
-        if na < 1e-3 * a.size or a.std() < 4:
-            continue
-        strip = Rf[y - H:y + H + 1, x - hi - H:x - lo + H + 1]
-        scores = []
-        for d in range(lo, hi + 1):
-            c0 = x - d - (x - hi - H) - H
-            b = strip[:, c0:c0 + 2 * H + 1].ravel(); b = b - b.mean(); nb = np.linalg.norm(b)
-            scores.append(a @ b / (na * nb + 1e-9))
-        scores = np.array(scores); k = int(np.argmax(scores))
-        if k == 0 or k == len(scores) - 1 or scores[k] < 0.9:
-            continue
-        mask = np.abs(np.arange(len(scores)) - k) > 2
-        if mask.any() and scores[mask].max() > scores[k] - 0.05:
-            continue
-        sm, s0, sp = scores[k - 1], scores[k], scores[k + 1]
-        den = sm - 2 * s0 + sp
-        sub = 0.5 * (sm - sp) / den if den < 0 else 0.0
-        disp = lo + k + sub
-        ds = fb / disp
-        # colour of the point in camera 2
-        X = np.array([(x - cx) * ds / f, (y - cy) * ds / f, ds, 1.0])
-        u2 = P2 @ X; u2 = u2[:2] / u2[2]
-        xi, yi = int(round(u2[0])), int(round(u2[1]))
-        if not (2 <= xi < C.shape[1] - 2 and 2 <= yi < C.shape[0] - 2):
-            continue
-        bgr = C[yi - 2:yi + 3, xi - 2:xi + 3].reshape(-1, 3).astype(float).mean(0)
-        ssum = bgr.sum() + 1e-6
-        exg = (2 * bgr[1] - bgr[2] - bgr[0]) / ssum
-        rows.append((i, x, y, dl, ds, spread, exg, s0))
+        bgr = colour[y2 - 2:y2 + 3, x2 - 2:x2 + 3].reshape(-1, 3).astype(float).mean(0)
+        rows.append((zl, zs, (2 * bgr[1] - bgr[2] - bgr[0]) / (bgr.sum() + 1e-6)))
 rows = np.array(rows)
-rel = rows[:, 3] / rows[:, 4] - 1
+rel = rows[:, 0] / rows[:, 1] - 1
 print(f'{seq_path}: {len(rows)} keypoints with both depths, fit {fit}')
+
+
 def show(name, m):
-    if m.sum() < 10: print(f'  {name:34s} n={m.sum()}'); return
+    if m.sum() < 10:
+        print(f'  {name:34s} n={m.sum()}')
+        return
     r = rel[m]
-    print(f'  {name:34s} n={m.sum():5d} median {100*np.median(r):+6.2f} %  mean {100*np.mean(np.clip(r,-0.3,0.3)):+6.2f} %  >2% far {100*np.mean(r>0.02):4.1f} %  >2% near {100*np.mean(r<-0.02):4.1f} %')
-veg = rows[:, 6] > 0.06
+    print(f'  {name:34s} n={m.sum():5d} median {100 * np.median(r):+6.2f} %  mean {100 * np.mean(np.clip(r, -0.3, 0.3)):+6.2f} %'
+          f'  >2% far {100 * np.mean(r > 0.02):4.1f} %  >2% near {100 * np.mean(r < -0.02):4.1f} %')
+
+
+green = rows[:, 2] > 0.06
 show('all', np.ones(len(rows), bool))
 for lo, hi in ((3, 8), (8, 15), (15, 40)):
-    d = (rows[:, 4] >= lo) & (rows[:, 4] < hi)
-    show(f'{lo}-{hi} m green (ExG>0.06)', d & veg)
-    show(f'{lo}-{hi} m other', d & ~veg)
+    d = (rows[:, 1] >= lo) & (rows[:, 1] < hi)
+    show(f'{lo}-{hi} m green (ExG>0.06)', d & green)
+    show(f'{lo}-{hi} m other', d & ~green)

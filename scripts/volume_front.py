@@ -68,8 +68,8 @@ class Street:
         self.fx, self.fy, self.cx, self.cy = self.P[0, 0], self.P[1, 1], self.P[0, 2], self.P[1, 2]
         h, w = self.image(0).shape
         self.shape = (h, w)
-        camera = rgbl.PinholeCamera(self.fx, self.fy, self.cx, self.cy, w, h)
-        self.calibration = rgbl.CameraCalibration(camera, T_cam_lidar=self.Tr)
+        self.camera = rgbl.PinholeCamera(self.fx, self.fy, self.cx, self.cy, w, h)
+        self.calibration = rgbl.CameraCalibration(self.camera, T_cam_lidar=self.Tr)
 
     def image(self, t):
         return cv2.imread(os.path.join(self.seq, 'image_0', self.frames[t]), cv2.IMREAD_GRAYSCALE)
@@ -80,8 +80,14 @@ class Street:
     def exact(self, t):
         return cv2.imread(os.path.join(self.seq, 'depth', self.frames[t]), cv2.IMREAD_UNCHANGED).astype(np.float64) / 256.0
 
-    def unproject(self, u, v, z):
-        return np.array([(u - self.cx) * z / self.fx, (v - self.cy) * z / self.fy, z, 1.0])
+    def world_point(self, t, u, v, z):
+        """the point at pixel (u, v) and depth z of frame t, in the world (true poses)"""
+        return (self.T[t] @ np.array([*self.camera.unproject((float(u), float(v)), float(z)), 1.0]))[:3]
+
+    def windows(self, span):
+        """(first frame K, frames K..K+span) of every 10th frame, as the over-frames rules follow them"""
+        n = len(self.frames)
+        return [(K, range(K, min(n, K + span + 1))) for K in range(0, n - 5, 10)]
 
 
 def window_rule(street, first, last, deg, gate, band):
@@ -107,14 +113,16 @@ def window_rule(street, first, last, deg, gate, band):
             vv, uu = np.nonzero(np.isfinite(win))
             d = win[vv, uu]
             keep = np.abs(d - z) < band * z
-            moved = z
+            moved, scatter, skew = z, 0.0, 0.0
             if keep.sum() >= 6:
                 A = np.c_[np.ones(keep.sum()), uu[keep] + x0 - px, vv[keep] + y0 - py]
                 coef, *_ = np.linalg.lstsq(A, 1.0 / d[keep], rcond=None)
                 r = d[keep] - 1.0 / (A @ coef)
-                if np.sqrt(np.sum(r ** 2) / max(1, len(r) - 3)) > gate * SIGMA:
+                scatter = np.sqrt(np.sum(r ** 2) / max(1, len(r) - 3))
+                skew = np.mean(r ** 3) / max(np.mean(r ** 2), 1e-12) ** 1.5
+                if scatter > gate * SIGMA:
                     moved = min(z, z + r.min() + SIGMA * np.sqrt(2 * np.log(len(r))))
-            rows.append((x, z, moved, true_z))
+            rows.append((x, z, moved, true_z, scatter, skew))
     a = np.array(rows)
     before, after = a[:, 1] / a[:, 3] - 1, a[:, 2] / a[:, 3] - 1
     fired = a[:, 2] < a[:, 1]
@@ -125,6 +133,12 @@ def window_rule(street, first, last, deg, gate, band):
         if m.any():
             print(f'  {name:26s} n={m.sum():5d}  mean {100 * before[m].mean():+.2f} % -> {100 * after[m].mean():+.2f} %, '
                   f'median {100 * np.median(before[m]):+.2f} % -> {100 * np.median(after[m]):+.2f} %')
+    # does the residuals' skewness tell leaves (one-sided) from geometry where the samples scatter?
+    for name, m in (('hedge', hedge), ('elsewhere', ~hedge)):
+        wide = m & (a[:, 4] > 4 * SIGMA)
+        if wide.sum() > 5:
+            print(f'  skewness where the scatter exceeds 4 sigma, {name}: quartiles '
+                  f'{np.round(np.percentile(a[wide, 5], [25, 50, 75]), 2)} ({wide.sum()} keypoints)')
 
 
 def landmark_rule(street, span, radius, allow):
@@ -138,27 +152,31 @@ def landmark_rule(street, span, radius, allow):
         return (M[:3, :3] @ p.T + M[:3, 3:4]).T
 
     rows = []  # z, bias, spread, skew, depth moved to the front, true surface beyond the 5th percentile
-    for K in range(0, len(street.frames) - 5, 10):
+    windows = street.windows(span)
+    marks = {}  # K -> [(world point, true z, surface-mean bias)]
+    for K, _ in windows:
         image, raw, truth = street.image(K), street.raw(K), street.exact(K)
         pixels = np.array([k.pt for k in orb.detect(image, None)], np.float32).reshape(-1, 2)
         source.prepare(image, raw)
-        marks = []  # world point, true z, surface-mean bias
+        marks[K] = []
         for (u, v), (z, _, spread, _) in zip(pixels, np.asarray(source.sample(pixels))):
             true_z = truth[int(np.floor(v + .5)), int(np.floor(u + .5))]
-            if not 1 < true_z < 30 or not z > 0 or spread > max(1.0, 0.05 * z):
-                continue
-            marks.append(((street.T[K] @ street.unproject(u, v, true_z))[:3], true_z, z - true_z))
-        if not marks:
+            if 1 < true_z < 30 and z > 0 and spread <= max(1.0, 0.05 * z):
+                marks[K].append((street.world_point(K, u, v, true_z), true_z, z - true_z))
+    gathered = {K: [[] for _ in marks[K]] for K, _ in windows}
+    for t in range(len(street.frames)):  # each scan once, for every window that holds it
+        active = [K for K, frames in windows if t in frames and marks[K]]
+        if not active:
             continue
-        X = np.array([m[0] for m in marks])
-        gathered = [[] for _ in marks]
-        for t in range(K, min(len(street.frames), K + span + 1)):
-            points = scan_world(t)
-            for j, near in enumerate(cKDTree(points).query_ball_point(X, radius)):
+        points = scan_world(t)
+        tree = cKDTree(points)
+        for K in active:
+            for j, near in enumerate(tree.query_ball_point(np.array([m[0] for m in marks[K]]), radius)):
                 if near:
-                    gathered[j].append(points[near])
+                    gathered[K][j].append(points[near])
+    for K, _ in windows:
         centre_K = street.T[K][:3, 3]
-        for (x, true_z, bias), parts in zip(marks, gathered):
+        for (x, true_z, bias), parts in zip(marks[K], gathered[K]):
             if not parts:
                 continue
             Q = np.vstack(parts)
@@ -202,19 +220,25 @@ def kernel_rule(street, span):
     orb = cv2.ORB_create(2000)
     h, w = street.shape
     rows = []  # bias of the surface mean (median over frames), gap mean - minimum (median over frames)
-    for K in range(0, len(street.frames) - 5, 10):
+    windows = street.windows(span)
+    marks = {}  # K -> world points of its keypoints
+    for K, _ in windows:
         truth = street.exact(K)
-        marks = []
+        marks[K] = []
         for k in orb.detect(street.image(K), None):
             true_z = truth[int(np.floor(k.pt[1] + .5)), int(np.floor(k.pt[0] + .5))]
             if 1 < true_z < 40:
-                marks.append((street.T[K] @ street.unproject(k.pt[0], k.pt[1], true_z)))
-        seen = [[] for _ in marks]
-        for t in range(K, min(len(street.frames), K + span + 1)):
-            image, raw, exact = street.image(t), street.raw(t), street.exact(t)
-            inverse = np.linalg.inv(street.T[t])
-            pixels, which, depths = [], [], []
-            for j, X in enumerate(marks):
+                marks[K].append(np.append(street.world_point(K, k.pt[0], k.pt[1], true_z), 1.0))
+    seen = {K: [[] for _ in marks[K]] for K, _ in windows}
+    for t in range(len(street.frames)):  # each frame prepared once, for every window that holds it
+        active = [K for K, frames in windows if t in frames]
+        if not active:
+            continue
+        exact = street.exact(t)
+        inverse = np.linalg.inv(street.T[t])
+        pixels, which, depths = [], [], []
+        for K in active:
+            for j, X in enumerate(marks[K]):
                 c = inverse @ X
                 if c[2] < 1:
                     continue
@@ -223,16 +247,18 @@ def kernel_rule(street, span):
                     continue
                 if not abs(exact[int(np.floor(v + .5)), int(np.floor(u + .5))] / c[2] - 1) < 0.03:
                     continue  # hidden in frame t
-                pixels.append((u, v)); which.append(j); depths.append(c[2])
-            if not pixels:
-                continue
-            pixels = np.array(pixels, np.float32)
-            mean_source.prepare(image, raw); means = np.asarray(mean_source.sample(pixels))
-            min_source.prepare(image, raw); minima = np.asarray(min_source.sample(pixels))[:, 0]
-            for j, z, (zm, _, spread, _), zn in zip(which, depths, means, minima):
-                if zm > 0 and zn > 0 and spread <= max(1.0, 0.05 * zm):
-                    seen[j].append((zm - z, zm - zn))
-        for o in seen:
+                pixels.append((u, v)); which.append((K, j)); depths.append(c[2])
+        if not pixels:
+            continue
+        image, raw = street.image(t), street.raw(t)
+        pixels = np.array(pixels, np.float32)
+        mean_source.prepare(image, raw); means = np.asarray(mean_source.sample(pixels))
+        min_source.prepare(image, raw); minima = np.asarray(min_source.sample(pixels))[:, 0]
+        for (K, j), z, (zm, _, spread, _), zn in zip(which, depths, means, minima):
+            if zm > 0 and zn > 0 and spread <= max(1.0, 0.05 * zm):
+                seen[K][j].append((zm - z, zm - zn))
+    for K, _ in windows:
+        for o in seen[K]:
             if len(o) >= 8:
                 o = np.array(o)
                 rows.append((np.median(o[:, 0]), np.median(o[:, 1])))

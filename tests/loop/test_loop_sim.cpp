@@ -411,7 +411,9 @@ TEST_CASE("map merging: the new map after a jump is bridged to the old one by re
   // repeats it (with the ring plane fit: 0.317 m at frame 54 and again at frame 162), which no bridge
   // can mend.
   const auto gap = std::adjacent_find(fed.begin(), fed.end(), [](std::size_t a, std::size_t b) { return b != a + 1; });
-  const double worst_before = *std::max_element(bridged.error.begin(), bridged.error.begin() + (gap - fed.begin() + 1));
+  const auto before_gap = gap == fed.end() ? fed.size() : static_cast<std::size_t>(gap - fed.begin()) + 1;
+  const double worst_before =
+      *std::max_element(bridged.error.begin(), bridged.error.begin() + static_cast<std::ptrdiff_t>(before_gap));
   fmt::print("a jump on the first lap bridged at frame {}: error there {:.3f} m (without merging {:.3f} m), at most "
              "{:.3f} m to the end (at most {:.3f} m before the gap); ATE {:.3f} m, without merging {:.3f} m\n",
              fed[*bridge_at], bridged.error[*bridge_at], apart.error[*bridge_at], worst_after, worst_before,
