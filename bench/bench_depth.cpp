@@ -1,6 +1,7 @@
 #include "bench_data.hpp"
 #include "reference/dilation_reference.hpp"
 #include "reference/occlusion_reference.hpp"
+#include "reference/ring_spacing_reference.hpp"
 #include "rgbl/depth/completion.hpp"
 #include "rgbl/depth/ip_basic.hpp"
 #include "rgbl/geometry/projection.hpp"
@@ -103,6 +104,17 @@ void keypoint_depth_reference(benchmark::State& state) {
   }
 }
 
+// The rings' spacing in the projected scan (the kernel's growth for sparser LiDARs; KITTI: 5 px).
+void ring_spacing_rgbl(benchmark::State& state) {
+  const cv::Mat_<float> sparse = sparse_frame();
+  for (auto _ : state) benchmark::DoNotOptimize(rgbl::ring_spacing_px(sparse));
+}
+
+void ring_spacing_reference(benchmark::State& state) {
+  const cv::Mat_<float> sparse = sparse_frame();
+  for (auto _ : state) benchmark::DoNotOptimize(rgbl::reference::ring_spacing_px(sparse));
+}
+
 void ip_basic_fast_rgbl(benchmark::State& state) {
   const cv::Mat_<float> sparse = sparse_frame();
   for (auto _ : state) {
@@ -119,4 +131,6 @@ BENCHMARK(occlusion_rgbl)->Name("occlusion/rgbl")->Unit(benchmark::kMillisecond)
 BENCHMARK(occlusion_reference)->Name("occlusion/reference")->Unit(benchmark::kMillisecond);
 BENCHMARK(keypoint_depth_rgbl)->Name("keypoint_depth/rgbl")->Unit(benchmark::kMillisecond);
 BENCHMARK(keypoint_depth_reference)->Name("keypoint_depth/reference")->Unit(benchmark::kMillisecond);
+BENCHMARK(ring_spacing_rgbl)->Name("ring_spacing/rgbl")->Unit(benchmark::kMicrosecond);
+BENCHMARK(ring_spacing_reference)->Name("ring_spacing/reference")->Unit(benchmark::kMicrosecond);
 BENCHMARK(ip_basic_fast_rgbl)->Name("ip_basic_fast/rgbl")->Unit(benchmark::kMillisecond);

@@ -28,6 +28,8 @@ void LidarSourceOptions::validate() const {
   projection.validate();
   dilation.validate();
   ip_basic.validate();
+  require(max_kernel_size >= dilation.size && max_kernel_size <= 63 && max_kernel_size % 2 == 1,
+          "lidar.max_kernel_size", "an odd size from dilation.size to 63");
   require(surface_tolerance >= 0.0F && surface_tolerance < 1.0F, "lidar.surface_tolerance", "a fraction in [0, 1)");
   require(occlusion_window_deg >= 0.0 && occlusion_window_deg < 5.0, "lidar.occlusion_window_deg", "0 (off) .. 5 deg");
   require(occlusion_ratio > 1.0F, "lidar.occlusion_ratio", "> 1");
@@ -151,6 +153,20 @@ class LidarDepthSource final : public DepthSource {
     }
     project_to_depth(frame.scan, P, options_.projection, sparse_);
     remove_occluded_samples(sparse_, occlusion_radius_, options_.occlusion_ratio, occlusion_scratch_);
+    dilation_ = options_.dilation;
+    fit_ = surface_fit_;
+    if (options_.kernel_from_ring_spacing && options_.completion == CompletionMethod::dilation) {
+      // Only beyond 1.5 times the configured size: the HDL-64's two blocks of lasers put its rings
+      // 4-6 px apart on KITTI, and the median spacing of a frame there is 5 or 6 px (raw drive 0009:
+      // 13 of its 51 frames 6): the 5x5 diamond was made for all of that range.
+      const auto spacing = ring_spacing_px(sparse_);
+      if (spacing && *spacing > 1.5 * options_.dilation.size) {
+        const int reach = static_cast<int>(*spacing / 2.0);
+        dilation_.size = std::clamp(2 * reach + 1, options_.dilation.size, options_.max_kernel_size);
+        // the road's plane fit between the rings above and below a keypoint needs both in its window
+        if (fit_.rows > 0) fit_.rows = std::max(fit_.rows, static_cast<int>(std::ceil(*spacing)));
+      }
+    }
     dense_.release();
     if (options_.completion != CompletionMethod::dilation) dense_ = complete();
   }
@@ -158,9 +174,9 @@ class LidarDepthSource final : public DepthSource {
   void sample(std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) const override {
     if (options_.completion == CompletionMethod::dilation) {
       if (options_.keypoint_depth == KeypointDepthRule::surface_mean) {
-        lookup_surface_depth(sparse_, options_.dilation, options_.surface_tolerance, pixels, out, surface_fit_);
+        lookup_surface_depth(sparse_, dilation_, options_.surface_tolerance, pixels, out, fit_);
       } else {
-        lookup_depth(sparse_, options_.dilation, pixels, out);
+        lookup_depth(sparse_, dilation_, pixels, out);
       }
       return;
     }
@@ -179,7 +195,7 @@ class LidarDepthSource final : public DepthSource {
  private:
   cv::Mat_<float> complete() const {
     switch (options_.completion) {
-      case CompletionMethod::dilation: return dilate_depth(sparse_, options_.dilation);
+      case CompletionMethod::dilation: return dilate_depth(sparse_, dilation_);
       case CompletionMethod::ip_basic_fast: return ip_basic_fast(sparse_, options_.ip_basic);
       case CompletionMethod::ip_basic_multiscale: return ip_basic_multiscale(sparse_, options_.ip_basic);
     }
@@ -191,6 +207,8 @@ class LidarDepthSource final : public DepthSource {
   Matrix34d P_img_lidar_;
   LidarSourceOptions options_;
   cv::Mat_<float> sparse_;
+  DilationOptions dilation_;  // this frame's: options_.dilation, grown with the ring spacing
+  SurfacePlaneFit fit_;       // this frame's: surface_fit_, its window grown with the ring spacing
   int occlusion_radius_ = 0;  // px, from occlusion_window_deg once
   SurfacePlaneFit surface_fit_;  // from surface_fit_window_deg and the camera, once
   cv::Mat_<float> occlusion_scratch_;

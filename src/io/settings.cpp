@@ -372,6 +372,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
     if (*v != 0 && *v != 1) r.fail(std::string(key), "0 (off) or 1 (on)");
     return *v == 1;
   };
+  s.kernel_from_ring_spacing = flag("LiDAR.KernelFromRingSpacing");
   s.loop_closing.enabled = flag("LoopClosing.Enabled");
   s.loop_closing.max_place_distance = r.number({"LoopClosing.MaxPlaceDistance"});
   if (const auto v = r.string({"LoopClosing.Places"})) {

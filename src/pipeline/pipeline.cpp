@@ -51,6 +51,7 @@ void apply_settings(const Settings& s, Resolved p) {
     p.lidar.dilation.shape = parse_kernel_shape(shape, "LiDAR.MethodInverseDilation.KernelType");
   }
   if (s.kernel_size > 0) p.lidar.dilation.size = s.kernel_size;
+  if (s.kernel_from_ring_spacing) p.lidar.kernel_from_ring_spacing = *s.kernel_from_ring_spacing;
   if (s.occlusion_window_deg) p.lidar.occlusion_window_deg = *s.occlusion_window_deg;
   if (s.occlusion_ratio) p.lidar.occlusion_ratio = static_cast<float>(*s.occlusion_ratio);
   if (s.surface_fit_window_deg) p.lidar.surface_fit_window_deg = *s.surface_fit_window_deg;

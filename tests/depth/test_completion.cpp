@@ -1,5 +1,6 @@
 #include "bench/reference/dilation_reference.hpp"
 #include "bench/reference/occlusion_reference.hpp"
+#include "bench/reference/ring_spacing_reference.hpp"
 #include "rgbl/core/error.hpp"
 #include "rgbl/depth/completion.hpp"
 #include "rgbl/geometry/calibration.hpp"
@@ -393,4 +394,51 @@ TEST_CASE("the occlusion filter equals the straightforward window scan, with one
   }
   cv::Mat_<float> empty(10, 10, 0.0F);
   CHECK(rgbl::remove_occluded_samples(empty, 4, 1.25F, scratch) == 0);
+}
+
+TEST_CASE("ring spacing: the median gap between a scan's rings in the image") {
+  // rings as rows of samples every `spacing` px, each ring's samples 2 px apart along it (as on KITTI,
+  // so one column alone misses a ring half the time), offset by one column from ring to ring
+  const auto rings = [](int spacing, int first_row = 3) {
+    cv::Mat_<float> sparse(300, 400, 0.0F);
+    for (int r = first_row, k = 0; r < sparse.rows; r += spacing, ++k) {
+      for (int c = k % 2; c < sparse.cols; c += 2) sparse(r, c) = 10.0F;
+    }
+    return sparse;
+  };
+  CHECK(rgbl::ring_spacing_px(rings(5)) == Approx(5.0));
+  CHECK(rgbl::ring_spacing_px(rings(10)) == Approx(10.0));
+  CHECK(rgbl::ring_spacing_px(rings(20)) == Approx(20.0));
+  // a ring that left no return in a band (sky, a dark car) makes one gap twice as long: not the median
+  cv::Mat_<float> holes = rings(10);
+  for (int c = 0; c < holes.cols; c += 96) holes.row(93).colRange(c, c + 3).setTo(0.0F);
+  CHECK(rgbl::ring_spacing_px(holes) == Approx(10.0));
+  // samples of one ring on neighbouring rows (a ring's curve in the image) are not a gap
+  cv::Mat_<float> curved = rings(10);
+  for (int c = 0; c < curved.cols; c += 2) curved(4, c) = 10.0F;
+  CHECK(rgbl::ring_spacing_px(curved) == Approx(10.0));
+  // too few gaps to tell: no spacing
+  CHECK_FALSE(rgbl::ring_spacing_px(cv::Mat_<float>(300, 400, 0.0F)).has_value());
+  cv::Mat_<float> two(300, 400, 0.0F);
+  two.row(10).setTo(5.0F);
+  two.row(30).setTo(5.0F);
+  CHECK_FALSE(rgbl::ring_spacing_px(two).has_value());  // 9 bands, one gap each
+  CHECK(rgbl::ring_spacing_px(two, 5) == Approx(20.0));
+}
+
+TEST_CASE("ring spacing on a real scan: the sampled bands agree with every band") {
+  const auto seq = rgbl::test::kitti_seq04();
+  if (!seq) return;
+  const auto kitti = rgbl::read_kitti_odometry_calibration(*seq / "calib.txt", 1226, 370);
+  const auto camera = kitti.camera(0);
+  for (const int frame : {0, 25, 50}) {
+    const auto scan = rgbl::read_kitti_scan(*seq / "velodyne" / fmt::format("{:06d}.bin", frame));
+    const cv::Mat_<float> sparse =
+        rgbl::project_to_depth(scan, camera.P_img_lidar(), camera.camera.width, camera.camera.height);
+    INFO("frame " << frame);
+    const auto spacing = rgbl::ring_spacing_px(sparse);
+    REQUIRE(spacing.has_value());
+    CHECK(*spacing == rgbl::reference::ring_spacing_px(sparse));
+    CHECK(*spacing == Approx(5.0));  // the HDL-64 on KITTI: its 5x5 diamond's own case
+  }
 }

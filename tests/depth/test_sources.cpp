@@ -414,3 +414,56 @@ TEST_CASE("lidar source: a scan taken before the image is moved to the image's t
   // depth from a camera of its own is the image's already
   CHECK_FALSE(ConstantSource(1.0F).measured_at_scan_time());
 }
+
+TEST_CASE("lidar source: the kernel grows with the rings' spacing in the image, not below 1.5 times its size") {
+  // a wall 10 m ahead seen by rings `spacing` px apart (samples every 2 px along each), f = 300 px,
+  // 800 x 300 px
+  rgbl::DepthSourceContext context;
+  context.calibration.camera.fx = context.calibration.camera.fy = 300.0;
+  context.calibration.camera.cx = 400.0;
+  context.calibration.camera.cy = 150.0;
+  context.calibration.camera.width = 800;  // 17 bands of ring_spacing_px
+  context.calibration.camera.height = 300;
+  const auto wall = [](int spacing) {
+    std::vector<rgbl::LidarPoint> scan;
+    for (int v = 10; v < 300; v += spacing) {
+      for (int u = 0; u < 800; u += 2) {
+        scan.push_back({static_cast<float>((u - 400) * 10.0 / 300.0), static_cast<float>((v - 150) * 10.0 / 300.0),
+                        10.0F, 0.0F});
+      }
+    }
+    return scan;
+  };
+  // depth at a keypoint half-way between two rings (and on a ring, for contrast)
+  const auto between = [&](const rgbl::LidarSourceOptions& options, int spacing) {
+    auto source = rgbl::make_lidar_source(options, context);
+    const std::vector<rgbl::LidarPoint> scan = wall(spacing);
+    rgbl::SensorFrame frame;
+    frame.scan = scan;  // a view
+    source->prepare(frame);
+    const std::vector<Eigen::Vector2f> pixels = {{400.0F, 10.0F + 4.0F * spacing + spacing / 2.0F},
+                                                 {400.0F, 10.0F + 4.0F * spacing}};
+    std::vector<rgbl::KeypointDepth> out(pixels.size());
+    source->sample(pixels, out);
+    CHECK(out[1].z == Approx(10.0F));
+    const cv::Mat_<float> dense = source->dense_depth();
+    CHECK(dense(cvRound(pixels[0].y()), 400) == out[0].z);  // the dense map with the same kernel
+    return out[0].z;
+  };
+  rgbl::LidarSourceOptions grows = simple_lidar();
+  rgbl::LidarSourceOptions fixed = simple_lidar();
+  fixed.kernel_from_ring_spacing = false;
+  // 20 px apart (KITTI with a 16-ring LiDAR): the 5x5 diamond leaves the keypoint 10 px from both
+  // rings without depth; the grown kernel (21) reaches them
+  CHECK(between(fixed, 20) == 0.0F);
+  CHECK(between(grows, 20) == Approx(10.0F));
+  // 6 px apart (KITTI's HDL-64 is 4-6): the kernel stays 5x5, 3 px is beyond its reach
+  CHECK(between(fixed, 6) == 0.0F);
+  CHECK(between(grows, 6) == 0.0F);
+  // and no further than max_kernel_size: 20 px from both rings 40 px apart, out of a 31x31's reach
+  CHECK(between(grows, 40) == 0.0F);
+  grows.max_kernel_size = 41;
+  CHECK(between(grows, 40) == Approx(10.0F));
+  grows.max_kernel_size = 4;
+  CHECK_THROWS_WITH(grows.validate(), Contains("lidar.max_kernel_size"));
+}

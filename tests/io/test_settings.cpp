@@ -195,6 +195,11 @@ TEST_CASE("settings: rgbl's LiDAR occlusion keys", "[io][settings]") {
   CHECK_FALSE(unset.surface_fit_window_deg);
   CHECK_THAT(error_of(tmp.write("f.yaml", "%YAML:1.0\nLiDAR.SurfaceFitWindowDeg: 5\n")),
              Contains("'LiDAR.SurfaceFitWindowDeg': expected 0 (off) .. 5 deg"));
+  CHECK(rgbl::read_settings(tmp.write("k.yaml", "%YAML:1.0\nLiDAR.KernelFromRingSpacing: 0\n")).kernel_from_ring_spacing ==
+        false);
+  CHECK_FALSE(unset.kernel_from_ring_spacing);
+  CHECK_THAT(error_of(tmp.write("k2.yaml", "%YAML:1.0\nLiDAR.KernelFromRingSpacing: 2\n")),
+             Contains("'LiDAR.KernelFromRingSpacing'"));
   const auto registration = rgbl::read_settings(tmp.write("g.yaml", "%YAML:1.0\nLiDAR.RegistrationSigmaDeg: 0.2\n"));
   CHECK(registration.registration_sigma_deg == 0.2);
   CHECK_FALSE(unset.registration_sigma_deg);

@@ -166,6 +166,10 @@ TEST_CASE("the settings file's LiDAR occlusion keys reach the LiDAR source") {
   const rgbl::Pipeline pipeline(o);
   CHECK(pipeline.lidar_options().occlusion_window_deg == 0.0);
   CHECK(pipeline.lidar_options().occlusion_ratio == 1.5F);
+  // the kernel's growth with the rings' spacing: on unless the file turns it off
+  CHECK(pipeline.lidar_options().kernel_from_ring_spacing);
+  o.settings = dir.write("rings.yaml", "%YAML:1.0\nLiDAR.KernelFromRingSpacing: 0\n");
+  CHECK_FALSE(rgbl::Pipeline(o).lidar_options().kernel_from_ring_spacing);
 }
 
 TEST_CASE("the settings file's LiDAR.TimeOffset reaches the system, overriding the dataset's scan times") {

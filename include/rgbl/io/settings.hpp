@@ -11,6 +11,7 @@
 //   LiDAR.MethodInverseDilation.KernelType, LiDAR.MethodInverseDilation.KernelSize_u,
 //   rgbl's own LiDAR.OcclusionWindowDeg (0 = off), LiDAR.OcclusionRatio (LidarSourceOptions::occlusion_*),
 //   LiDAR.SurfaceFitWindowDeg (LidarSourceOptions::surface_fit_window_deg, 0 = off, default 0.5),
+//   LiDAR.KernelFromRingSpacing (0/1, LidarSourceOptions::kernel_from_ring_spacing, default 1),
 //   LiDAR.RegistrationSigmaDeg (DepthNoiseModel::registration_sigma_deg, 0 = off, default 0.1),
 //   LiDAR.TimeOffset (SystemOptions::scan_time_offset: the image's time minus the scan's, seconds;
 //   overrides the dataset's scan timestamps, 0 = simultaneous),
@@ -81,6 +82,7 @@ struct Settings {
   std::optional<Eigen::Isometry3d> T_cam_lidar;
   std::string kernel_type;            // e.g. "Diamond"; empty when absent
   int kernel_size = 0;                // 0 when absent
+  std::optional<bool> kernel_from_ring_spacing;  // LiDAR.KernelFromRingSpacing; unset = the source's default (on)
   std::optional<double> occlusion_window_deg;  // LiDAR.OcclusionWindowDeg; unset = the source's default
   std::optional<double> occlusion_ratio;       // LiDAR.OcclusionRatio; unset = the source's default
   std::optional<double> surface_fit_window_deg;  // LiDAR.SurfaceFitWindowDeg; unset = the source's default (0.5)
