@@ -17,8 +17,9 @@
 # with the plain street's at the same frame count and seed.
 # Each real drive of at least 30 frames also runs as harder variants of itself: at 3.3 and 1.7 Hz
 # (--step 3, --step 6), with a forward-driving camera's motion blur (60 per mille: 37 px at the side
-# edges), with exposure jumps (+-30 %), and blurred at 3.3 Hz (scripts/degrade.py, which needs Debian's
-# python3-opencv; those rows are skipped without it). The LiDAR and the ground truth stay real.
+# edges), with exposure jumps (+-30 %), blurred at 3.3 Hz, and with a sparser LiDAR: every second ring
+# of the HDL-64 (a 32-ring sensor) and every fourth (16 rings) (scripts/degrade.py, which needs Debian's
+# python3-opencv; those rows are skipped without it). The ground truth stays real.
 # Data: $RGBL_DATA, else ../shared/data next to the repository. Generated scenarios are cached in
 # $RGBL_CACHE (default ~/.cache/rgbl/scenarios), keyed by the simulator's sources, so a rerun after a
 # tracker change only tracks.
@@ -102,7 +103,7 @@ if [ "$real" = 1 ]; then
     if [ "$variants" = 1 ]; then
       have_cv=1
       /usr/bin/python3 -c "import cv2" 2> /dev/null || have_cv=0
-      [ "$have_cv" = 1 ] || echo "  (blurred and exposure variants skipped: scripts/degrade.py needs python3-opencv)"
+      [ "$have_cv" = 1 ] || echo "  (blurred, exposure and sparse-LiDAR variants skipped: scripts/degrade.py needs python3-opencv)"
       degrade_key="$(sha1sum < "$repo/scripts/degrade.py" | cut -c1-12)"
       for d in "${drives[@]}"; do
         read -r name folder <<< "$d"
@@ -110,7 +111,7 @@ if [ "$real" = 1 ]; then
         track "$name-step3" run "$folder" --step 3 "${extra[@]}"
         track "$name-step6" run "$folder" --step 6 "${extra[@]}"
         [ "$have_cv" = 1 ] || continue
-        for v in "blur60 --blur 60" "gain30 --gain 0.3"; do
+        for v in "blur60 --blur 60" "gain30 --gain 0.3" "rings32 --rings 2" "rings16 --rings 4"; do
           read -r vname vargs <<< "$v"
           # the copy keeps the layout: sequences/NN (poses two levels up) or <date>/<drive> (calibration one up)
           root="$cache/degraded/$name-$vname-$degrade_key"
