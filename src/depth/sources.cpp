@@ -28,8 +28,8 @@ void LidarSourceOptions::validate() const {
   projection.validate();
   dilation.validate();
   ip_basic.validate();
-  require(max_kernel_size >= dilation.size && max_kernel_size <= 63 && max_kernel_size % 2 == 1,
-          "lidar.max_kernel_size", "an odd size from dilation.size to 63");
+  require(max_kernel_size >= 1 && max_kernel_size <= 63 && max_kernel_size % 2 == 1, "lidar.max_kernel_size",
+          "an odd size 1..63 (the growth never goes below dilation.size)");
   require(surface_tolerance >= 0.0F && surface_tolerance < 1.0F, "lidar.surface_tolerance", "a fraction in [0, 1)");
   require(occlusion_window_deg >= 0.0 && occlusion_window_deg < 5.0, "lidar.occlusion_window_deg", "0 (off) .. 5 deg");
   require(occlusion_ratio > 1.0F, "lidar.occlusion_ratio", "> 1");
@@ -162,7 +162,8 @@ class LidarDepthSource final : public DepthSource {
       const auto spacing = ring_spacing_px(sparse_);
       if (spacing && *spacing > 1.5 * options_.dilation.size) {
         const int reach = static_cast<int>(*spacing / 2.0);
-        dilation_.size = std::clamp(2 * reach + 1, options_.dilation.size, options_.max_kernel_size);
+        dilation_.size = std::clamp(2 * reach + 1, options_.dilation.size,
+                                    std::max(options_.dilation.size, options_.max_kernel_size));
         // the road's plane fit between the rings above and below a keypoint needs both in its window
         if (fit_.rows > 0) fit_.rows = std::max(fit_.rows, static_cast<int>(std::ceil(*spacing)));
       }

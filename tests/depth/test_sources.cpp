@@ -466,4 +466,8 @@ TEST_CASE("lidar source: the kernel grows with the rings' spacing in the image, 
   CHECK(between(grows, 40) == Approx(10.0F));
   grows.max_kernel_size = 4;
   CHECK_THROWS_WITH(grows.validate(), Contains("lidar.max_kernel_size"));
+  // a configured kernel larger than max_kernel_size is kept, not refused
+  fixed.dilation.size = 41;
+  fixed.kernel_from_ring_spacing = true;
+  CHECK(between(fixed, 40) == Approx(10.0F));
 }
