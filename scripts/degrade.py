@@ -84,6 +84,8 @@ def main():
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--rings", type=int, default=1)
     args = parser.parse_args()
+    if args.rings < 1:
+        sys.exit("degrade.py: --rings takes a whole number >= 1")
     source = os.path.abspath(args.source.rstrip("/"))
     dest = os.path.abspath(args.dest.rstrip("/"))
     principal = principal_point(source)
@@ -108,8 +110,6 @@ def main():
     if args.blur <= 0 and args.gain <= 0:
         grey = []  # the images as they are, linked
     scans = [os.path.join(source, g) for g in SCAN_FOLDERS if os.path.isdir(os.path.join(source, g))]
-    if args.rings < 1:
-        sys.exit("degrade.py: --rings takes a whole number >= 1")
     if args.rings == 1:
         scans = []
     rewritten = grey + scans
