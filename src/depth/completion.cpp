@@ -439,8 +439,9 @@ void dilate_diamond5(const cv::Mat_<float>& sparse, const Inversion& inv, std::i
 }  // namespace
 
 std::optional<double> ring_spacing_px(const cv::Mat_<float>& sparse, std::size_t min_gaps) {
-  // a band of 3 columns every 48 (one 64-byte cache line in four is read): KITTI's 1241 px still
-  // give ~26 bands, ~1000 gaps of an HDL-64 and ~250 of every fourth ring
+  // a band of 3 columns every 48 (one 64-byte cache line in four is read): sequence 04's 1226 px give
+  // 26 bands, 966-1024 gaps a frame of the HDL-64 and 224-240 of every fourth ring (every 10th frame,
+  // a throwaway script). The simulator's 613 px give 13, too few for a 16-ring scan there.
   constexpr int kBand = 3, kStride = 48;
   const int bands = sparse.cols >= kBand ? (sparse.cols - kBand) / kStride + 1 : 0;
   std::vector<int> last(static_cast<std::size_t>(bands), -1);  // per band, the last row with a sample

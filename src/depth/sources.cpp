@@ -2,6 +2,7 @@
 
 #include "rgbl/core/error.hpp"
 #include "rgbl/core/file.hpp"
+#include "rgbl/core/log.hpp"
 #include "rgbl/io/image.hpp"
 #include "source_checks.hpp"
 
@@ -110,6 +111,17 @@ void sample_dense_depth(const cv::Mat_<float>& dense, const Kernel& kernel, std:
 
 namespace {
 
+// The kernel for LiDAR rings `spacing` px apart in the image (LidarSourceOptions::kernel_from_ring_spacing):
+// the configured one up to 1.5 times its size, beyond that one reaching half the spacing, at most
+// max_size (never below the configured size). Only beyond 1.5 times: the HDL-64's two blocks of lasers
+// put its rings 4-6 px apart on KITTI, and a frame's median spacing there is 5 or 6 px (raw drive 0009:
+// 15 of its 51 frames 6): the 5x5 diamond was made for all of that range.
+int kernel_size_for_rings(double spacing, int configured, int max_size) {
+  if (!(spacing > 1.5 * configured)) return configured;
+  const int reach = static_cast<int>(spacing / 2.0);
+  return std::clamp(2 * reach + 1, configured, std::max(configured, max_size));
+}
+
 // Distance from `p` to the nearest non-zero pixel centre of `sparse` within `radius`; radius + 1 if none.
 float nearest_sample_distance(const cv::Mat_<float>& sparse, const Eigen::Vector2f& p, int radius) {
   const int x = static_cast<int>(std::floor(p.x() + 0.5F)), y = static_cast<int>(std::floor(p.y() + 0.5F));
@@ -155,18 +167,17 @@ class LidarDepthSource final : public DepthSource {
     remove_occluded_samples(sparse_, occlusion_radius_, options_.occlusion_ratio, occlusion_scratch_);
     dilation_ = options_.dilation;
     fit_ = surface_fit_;
-    if (options_.kernel_from_ring_spacing && options_.completion == CompletionMethod::dilation) {
-      // Only beyond 1.5 times the configured size: the HDL-64's two blocks of lasers put its rings
-      // 4-6 px apart on KITTI, and the median spacing of a frame there is 5 or 6 px (raw drive 0009:
-      // 13 of its 51 frames 6): the 5x5 diamond was made for all of that range.
-      const auto spacing = ring_spacing_px(sparse_);
-      if (spacing && *spacing > 1.5 * options_.dilation.size) {
-        const int reach = static_cast<int>(*spacing / 2.0);
-        dilation_.size = std::clamp(2 * reach + 1, options_.dilation.size,
-                                    std::max(options_.dilation.size, options_.max_kernel_size));
-        // the road's plane fit between the rings above and below a keypoint needs both in its window
-        if (fit_.rows > 0) fit_.rows = std::max(fit_.rows, static_cast<int>(std::ceil(*spacing)));
+    const auto spacing = options_.kernel_from_ring_spacing && options_.completion == CompletionMethod::dilation
+                             ? ring_spacing_px(sparse_)
+                             : std::nullopt;
+    if (spacing && *spacing > options_.dilation.size) {
+      dilation_.size = kernel_size_for_rings(*spacing, options_.dilation.size, options_.max_kernel_size);
+      // the road's plane fit between the rings above and below a keypoint needs both in its window
+      if (dilation_.size != options_.dilation.size && fit_.rows > 0) {
+        fit_.rows = std::max(fit_.rows, static_cast<int>(std::ceil(*spacing)));
       }
+      logger()->debug("frame {}: LiDAR rings {} px apart in the image, dilation kernel {} (configured {})", frame.index,
+                      *spacing, dilation_.size, options_.dilation.size);
     }
     dense_.release();
     if (options_.completion != CompletionMethod::dilation) dense_ = complete();

@@ -326,10 +326,10 @@ TEST_CASE("dropped scans are survived", "[e2e]") {
 
 TEST_CASE("a 16-beam LiDAR starts the map and tracks", "[e2e]") {
   // Every fourth of the HDL-64-like beams (1.5 deg apart in the upper block) at KITTI's resolution, the
-  // rings 17-20 px apart in the image (docs/accuracy.md, "Sparser LiDARs"). With the paper's 5x5 diamond
+  // rings 21 px apart in the image (docs/accuracy.md, "Sparser LiDARs"). With the paper's 5x5 diamond
   // alone the first frame holds fewer keypoints with depth than the 300 initialisation once asked for,
   // and no frame was tracked; now it starts (measured: 251 on frame 0, 30 of 30 frames ok, ATE
-  // 0.012 m). By default the kernel grows with the rings' spacing (to 17-21 here) and gives more
+  // 0.012 m). By default the kernel grows with the rings' spacing (to 21 here) and gives more
   // keypoints depth (measured: 1107 on frame 0), but on this street it tracks worse (ATE 0.055 m):
   // between rings 20 px apart the nearer ring's depth wins off the level road. On KITTI thinned to 16
   // rings it is the other way round (over five samples 1.46 and 0.77 m with the 5x5 diamond, 0.048 and

@@ -42,7 +42,7 @@ struct LidarSourceOptions {
   // max_kernel_size; the road's plane fit (surface_fit_window_deg) then looks at least one spacing up
   // and down, to the rings either side. The paper's 5x5 diamond reaches half of KITTI's HDL-64 ring
   // spacing (4-6 px), which this leaves as it is; with every second ring (a 32-ring LiDAR) the kernel is
-  // 11, with every fourth (16 rings) 19-21. On KITTI 04 and raw drive 0009 thinned so (mean ATE over
+  // 11, with every fourth (16 rings) 19-23. On KITTI 04 and raw drive 0009 thinned so (mean ATE over
   // five samples) the 5x5 diamond's 0.107 / 0.103 m at 32 rings and 1.46 / 0.77 m at 16 (frames lost)
   // become 0.051 / 0.090 and 0.048 / 0.116 m; at 64 rings they are 0.063 / 0.090 m (docs/accuracy.md,
   // "Sparser LiDARs").
