@@ -439,18 +439,20 @@ void dilate_diamond5(const cv::Mat_<float>& sparse, const Inversion& inv, std::i
 }  // namespace
 
 std::optional<double> ring_spacing_px(const cv::Mat_<float>& sparse, std::size_t min_gaps) {
-  // a band of 3 columns every 48 (one 64-byte cache line in four is read): sequence 04's 1226 px give
+  // A band of 3 columns every 48 (one 64-byte cache line in four is read): sequence 04's 1226 px give
   // 26 bands, 966-1024 gaps a frame of the HDL-64 and 224-240 of every fourth ring (every 10th frame,
-  // a throwaway script). The simulator's 613 px give 13, too few for a 16-ring scan there.
-  constexpr int kBand = 3, kStride = 48;
-  const int bands = sparse.cols >= kBand ? (sparse.cols - kBand) / kStride + 1 : 0;
+  // a throwaway script). Narrower images keep those 26 bands with a shorter stride: at 48 the
+  // simulator's 613 px gave 13, too few gaps for a 16-ring scan after the occlusion filter.
+  constexpr int kBand = 3, kBands = 26, kMaxStride = 48;
+  const int stride = std::clamp((sparse.cols - kBand) / (kBands - 1), kBand, kMaxStride);
+  const int bands = sparse.cols >= kBand ? (sparse.cols - kBand) / stride + 1 : 0;
   std::vector<int> last(static_cast<std::size_t>(bands), -1);  // per band, the last row with a sample
   std::vector<int> gaps;
   gaps.reserve(static_cast<std::size_t>(bands) * 64);
   for (int r = 0; r < sparse.rows; ++r) {
     const float* row = sparse[r];
     for (int b = 0; b < bands; ++b) {
-      const float* cell = row + b * kStride;
+      const float* cell = row + b * stride;
       if (!(cell[0] > 0.0F || cell[1] > 0.0F || cell[2] > 0.0F)) continue;
       int& previous = last[static_cast<std::size_t>(b)];
       if (previous >= 0 && r - previous > 1) gaps.push_back(r - previous);

@@ -422,8 +422,16 @@ TEST_CASE("ring spacing: the median gap between a scan's rings in the image") {
   cv::Mat_<float> two(300, 400, 0.0F);
   two.row(10).setTo(5.0F);
   two.row(30).setTo(5.0F);
-  CHECK_FALSE(rgbl::ring_spacing_px(two).has_value());  // 9 bands, one gap each
-  CHECK(rgbl::ring_spacing_px(two, 5) == Approx(20.0));
+  CHECK_FALSE(rgbl::ring_spacing_px(two).has_value());  // 27 bands (a stride of 15), one gap each
+  CHECK(rgbl::ring_spacing_px(two, 27) == Approx(20.0));
+  CHECK_FALSE(rgbl::ring_spacing_px(two, 28).has_value());
+  // a narrow image keeps its 26 bands: 16 rings 10 px apart over 160 rows of a 613 px image give 26 x 15
+  // gaps; at one band every 48 columns (13 bands) they were 195, too few for the default 100 only after
+  // the occlusion filter thinned them, so here the count itself is checked
+  cv::Mat_<float> narrow(370, 613, 0.0F);
+  for (int r = 200; r < 360; r += 10) narrow.row(r).setTo(8.0F);
+  CHECK(rgbl::ring_spacing_px(narrow, 26 * 15) == Approx(10.0));
+  CHECK_FALSE(rgbl::ring_spacing_px(narrow, 26 * 15 + 1).has_value());
 }
 
 TEST_CASE("ring spacing on a real scan: the sampled bands agree with every band") {
