@@ -177,11 +177,13 @@ void bind_depth(py::module_& m) {
   m.def(
       "make_lidar_source",
       [](const CameraCalibration& calibration, double surface_fit_window_deg, double occlusion_window_deg,
-         float surface_tolerance) {
+         float surface_tolerance, int surface_step_px, bool kernel_from_ring_spacing) {
         LidarSourceOptions options;
         options.surface_fit_window_deg = surface_fit_window_deg;
         options.occlusion_window_deg = occlusion_window_deg;
         options.surface_tolerance = surface_tolerance;
+        options.surface_step_px = surface_step_px;
+        options.kernel_from_ring_spacing = kernel_from_ring_spacing;
         DepthSourceContext context;
         context.calibration = calibration;
         return PyDepthSource{make_lidar_source(options, context), py::tuple()};
@@ -190,9 +192,11 @@ void bind_depth(py::module_& m) {
       py::arg("calibration"), py::arg("surface_fit_window_deg") = LidarSourceOptions{}.surface_fit_window_deg,
       py::arg("occlusion_window_deg") = LidarSourceOptions{}.occlusion_window_deg,
       py::arg("surface_tolerance") = LidarSourceOptions{}.surface_tolerance,
+      py::arg("surface_step_px") = LidarSourceOptions{}.surface_step_px,
+      py::arg("kernel_from_ring_spacing") = LidarSourceOptions{}.kernel_from_ring_spacing,
       "The 'lidar' source (5x5 diamond, surface-mean keypoint depth) with its options: the settings keys "
-      "LiDAR.SurfaceFitWindowDeg, LiDAR.OcclusionWindowDeg and the surface's relative depth step. Raises "
-      "ConfigError naming an option out of range.");
+      "LiDAR.SurfaceFitWindowDeg, LiDAR.OcclusionWindowDeg, the surface's relative depth step, "
+      "LiDAR.SurfaceStepPx and LiDAR.KernelFromRingSpacing. Raises ConfigError naming an option out of range.");
   m.def("read_depth_png", [](const std::filesystem::path& file) { return mat_array(read_depth_png(file)); },
         py::arg("file"), "A depth PNG (uint16, depth x 256) in metres, float32 H x W.");
   m.def(

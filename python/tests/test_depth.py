@@ -141,3 +141,5 @@ def test_lidar_source_plane_fit_between_rings():
     assert fit.sample(keypoint)[0, 0] == pytest.approx(exact, rel=1e-5)
     with pytest.raises(rgbl.ConfigError, match="surface_fit_window_deg"):
         rgbl.make_lidar_source(calibration, surface_fit_window_deg=-1.0)
+    with pytest.raises(rgbl.ConfigError, match="surface_step_px"):
+        rgbl.make_lidar_source(calibration, surface_step_px=0)

@@ -712,7 +712,7 @@ std::optional<PlaneDepth> fit_surface_plane(const cv::Mat_<float>& sparse, int r
 }
 
 KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const Cell> cells, int radius,
-                                 const Inversion& inv, float surface_tolerance, const SurfacePlaneFit& fit,
+                                 const Inversion& inv, float surface_tolerance, int step_px, const SurfacePlaneFit& fit,
                                  double min_cos_tilt, const Eigen::Vector2f& pixel, SurfaceScratch& scratch) {
   KeypointDepth result;
   const KernelWindow window(sparse, radius, pixel);
@@ -728,8 +728,9 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
     samples.push_back({cell, d, false});
   }
   if (samples.empty()) return result;
-  // The winning surface grows from the nearest sample through samples within 2 px of it whose depths
-  // differ by at most surface_tolerance: a slanted road joins row by row, a jump to the background does not.
+  // The winning surface grows from the nearest sample through samples within step_px columns and 2 rows
+  // of it whose depths differ by at most surface_tolerance: a slanted road joins row by row, a jump to
+  // the background does not.
   // Breadth-first: each sample joins once, so the cost is quadratic in the samples under the kernel.
   samples[nearest].on_surface = true;
   auto& frontier = scratch.frontier;
@@ -739,7 +740,7 @@ KeypointDepth lookup_surface_one(const cv::Mat_<float>& sparse, std::span<const 
     frontier.pop_back();
     for (std::size_t i = 0; i < samples.size(); ++i) {
       SurfaceSample& s = samples[i];
-      if (s.on_surface || std::abs(s.cell.dx - t.cell.dx) > 2 || std::abs(s.cell.dy - t.cell.dy) > 2) continue;
+      if (s.on_surface || std::abs(s.cell.dx - t.cell.dx) > step_px || std::abs(s.cell.dy - t.cell.dy) > 2) continue;
       if (std::abs(s.d - t.d) > surface_tolerance * std::min(s.d, t.d)) continue;
       s.on_surface = true;
       frontier.push_back(i);
@@ -781,9 +782,10 @@ void SurfacePlaneFit::validate() const {
 
 void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, float surface_tolerance,
                           std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out,
-                          const SurfacePlaneFit& fit) {
+                          const SurfacePlaneFit& fit, int step_px) {
   options.validate();
   require(surface_tolerance >= 0.0F && surface_tolerance < 1.0F, "lidar.surface_tolerance", "a fraction in [0, 1)");
+  require(step_px >= 1 && step_px <= 15, "lidar.surface_step_px", "1 .. 15 px");
   fit.validate();
   CV_Assert(out.size() == pixels.size());
   const Kernel kernel = options.kernel();
@@ -794,8 +796,8 @@ void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& 
   scratch.samples.reserve(cells.size());
   scratch.frontier.reserve(cells.size());
   for (std::size_t i = 0; i < pixels.size(); ++i) {
-    out[i] = lookup_surface_one(sparse, cells, kernel.radius(), inv, surface_tolerance, fit, min_cos_tilt, pixels[i],
-                                scratch);
+    out[i] = lookup_surface_one(sparse, cells, kernel.radius(), inv, surface_tolerance, step_px, fit, min_cos_tilt,
+                                pixels[i], scratch);
   }
 }
 

@@ -32,6 +32,7 @@ void LidarSourceOptions::validate() const {
   require(max_kernel_size >= 1 && max_kernel_size <= 63 && max_kernel_size % 2 == 1, "lidar.max_kernel_size",
           "an odd size 1..63 (the growth never goes below dilation.size)");
   require(surface_tolerance >= 0.0F && surface_tolerance < 1.0F, "lidar.surface_tolerance", "a fraction in [0, 1)");
+  require(surface_step_px >= 1 && surface_step_px <= 15, "lidar.surface_step_px", "1 .. 15 px");
   require(occlusion_window_deg >= 0.0 && occlusion_window_deg < 5.0, "lidar.occlusion_window_deg", "0 (off) .. 5 deg");
   require(occlusion_ratio > 1.0F, "lidar.occlusion_ratio", "> 1");
   require(surface_fit_window_deg >= 0.0 && surface_fit_window_deg < 5.0, "lidar.surface_fit_window_deg", "0 (off) .. 5 deg");
@@ -186,7 +187,7 @@ class LidarDepthSource final : public DepthSource {
   void sample(std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out) const override {
     if (options_.completion == CompletionMethod::dilation) {
       if (options_.keypoint_depth == KeypointDepthRule::surface_mean) {
-        lookup_surface_depth(sparse_, dilation_, options_.surface_tolerance, pixels, out, fit_);
+        lookup_surface_depth(sparse_, dilation_, options_.surface_tolerance, pixels, out, fit_, options_.surface_step_px);
       } else {
         lookup_depth(sparse_, dilation_, pixels, out);
       }

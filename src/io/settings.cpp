@@ -357,6 +357,10 @@ Settings read_settings(const std::filesystem::path& yaml) {
     if (!(*v >= 0.0 && *v < 5.0)) r.fail("LiDAR.SurfaceFitWindowDeg", "0 (off) .. 5 deg");
     s.surface_fit_window_deg = *v;
   }
+  if (const auto v = r.integer({"LiDAR.SurfaceStepPx"})) {
+    if (!(*v >= 1 && *v <= 15)) r.fail("LiDAR.SurfaceStepPx", "1 .. 15 px");
+    s.surface_step_px = static_cast<int>(*v);
+  }
   if (const auto v = r.number({"LiDAR.RegistrationSigmaDeg"})) {
     if (!(*v >= 0.0 && *v < 5.0)) r.fail("LiDAR.RegistrationSigmaDeg", "0 (off) .. 5 deg");
     s.registration_sigma_deg = *v;

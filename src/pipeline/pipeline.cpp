@@ -55,6 +55,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.occlusion_window_deg) p.lidar.occlusion_window_deg = *s.occlusion_window_deg;
   if (s.occlusion_ratio) p.lidar.occlusion_ratio = static_cast<float>(*s.occlusion_ratio);
   if (s.surface_fit_window_deg) p.lidar.surface_fit_window_deg = *s.surface_fit_window_deg;
+  if (s.surface_step_px) p.lidar.surface_step_px = *s.surface_step_px;
   if (s.registration_sigma_deg) p.system.depth_noise.registration_sigma_deg = *s.registration_sigma_deg;
   if (s.scan_time_offset) p.system.scan_time_offset = *s.scan_time_offset;
   if (s.T_cam_lidar) {

@@ -195,6 +195,10 @@ TEST_CASE("settings: rgbl's LiDAR occlusion keys", "[io][settings]") {
   CHECK_FALSE(unset.surface_fit_window_deg);
   CHECK_THAT(error_of(tmp.write("f.yaml", "%YAML:1.0\nLiDAR.SurfaceFitWindowDeg: 5\n")),
              Contains("'LiDAR.SurfaceFitWindowDeg': expected 0 (off) .. 5 deg"));
+  CHECK(rgbl::read_settings(tmp.write("st.yaml", "%YAML:1.0\nLiDAR.SurfaceStepPx: 4\n")).surface_step_px == 4);
+  CHECK_FALSE(unset.surface_step_px);
+  CHECK_THAT(error_of(tmp.write("st0.yaml", "%YAML:1.0\nLiDAR.SurfaceStepPx: 0\n")),
+             Contains("'LiDAR.SurfaceStepPx': expected 1 .. 15 px"));
   CHECK(rgbl::read_settings(tmp.write("k.yaml", "%YAML:1.0\nLiDAR.KernelFromRingSpacing: 0\n")).kernel_from_ring_spacing ==
         false);
   CHECK_FALSE(unset.kernel_from_ring_spacing);

@@ -170,6 +170,9 @@ TEST_CASE("the settings file's LiDAR occlusion keys reach the LiDAR source") {
   CHECK(pipeline.lidar_options().kernel_from_ring_spacing);
   o.settings = dir.write("rings.yaml", "%YAML:1.0\nLiDAR.KernelFromRingSpacing: 0\n");
   CHECK_FALSE(rgbl::Pipeline(o).lidar_options().kernel_from_ring_spacing);
+  CHECK(pipeline.lidar_options().surface_step_px == 2);
+  o.settings = dir.write("step.yaml", "%YAML:1.0\nLiDAR.SurfaceStepPx: 4\n");
+  CHECK(rgbl::Pipeline(o).lidar_options().surface_step_px == 4);
 }
 
 TEST_CASE("the settings file's LiDAR.TimeOffset reaches the system, overriding the dataset's scan times") {

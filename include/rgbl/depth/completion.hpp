@@ -102,8 +102,10 @@ struct SurfacePlaneFit {
 // mean, in inverse depth, of the samples on that surface instead of the nearest depth itself: on every
 // slanted surface the minimum comes from the side that faces the camera (on the road about
 // z^2 / (fx h) per pixel of kernel), the mean does not. The surface grows from the nearest sample
-// through samples within 2 px whose depths differ by at most surface_tolerance (relative), so a road
-// joins row by row and a background behind an edge stays out. Weights are 1 / max(distance, 0.5 px).
+// through samples within step_px columns and 2 rows whose depths differ by at most surface_tolerance
+// (relative), so a road joins row by row and a background behind an edge stays out. Where a ring's
+// samples lie further apart along it than step_px, the surface stops at the first such gap: on a
+// grown kernel only the end that faces the camera is left (LidarSourceOptions::surface_step_px). Weights are 1 / max(distance, 0.5 px).
 // sample_distance_px is the nearest surface sample's distance; spread is as for lookup_depth. Pixels
 // outside the image get z = 0.
 // fit.rows > 0: z comes instead from a plane fitted, in inverse depth (affine in the pixel on a plane),
@@ -116,7 +118,7 @@ struct SurfacePlaneFit {
 // surface_tolerance per 2 rows; the fit is kept only within 3 x surface_tolerance of the mean.
 void lookup_surface_depth(const cv::Mat_<float>& sparse, const DilationOptions& options, float surface_tolerance,
                           std::span<const Eigen::Vector2f> pixels, std::span<KeypointDepth> out,
-                          const SurfacePlaneFit& fit = {});
+                          const SurfacePlaneFit& fit = {}, int step_px = 2);
 
 // Drops the samples of `sparse` that the camera cannot see: a sample with a sample nearer by more than
 // the factor `ratio` within `radius` px (a square) lies behind a foreground edge in the camera's view.

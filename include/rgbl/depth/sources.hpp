@@ -51,6 +51,13 @@ struct LidarSourceOptions {
   IpBasicOptions ip_basic{};
   KeypointDepthRule keypoint_depth = KeypointDepthRule::surface_mean;
   float surface_tolerance = 0.05F;  // relative depth step between neighbouring samples of one surface
+  // The columns a step between two samples of one surface may span (lookup_surface_depth; rows: 2). On
+  // a grown kernel a ring whose samples lie 3 px apart in one image row breaks the surface at 2, and the
+  // keypoint gets the depth of the ring's end nearest the camera: the simulator at 1226 px with 16 rings
+  // tracks at 0.086 m with 2 and 0.015 m with 4 (64 rings: 0.018 m). Not the default: KITTI's drives
+  // thinned to 32 and 16 rings track worse with 4 in three of four (docs/accuracy.md, "A ring's samples
+  // 3 px apart").
+  int surface_step_px = 2;
   // Samples behind a foreground edge in the camera's view are dropped before completion
   // (remove_occluded_samples): those with a sample nearer by occlusion_ratio within occlusion_window_deg
   // (as an angle, so the same at any resolution: 4 px on KITTI's 1241 px images). A road changes its

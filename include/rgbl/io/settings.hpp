@@ -11,6 +11,7 @@
 //   LiDAR.MethodInverseDilation.KernelType, LiDAR.MethodInverseDilation.KernelSize_u,
 //   rgbl's own LiDAR.OcclusionWindowDeg (0 = off), LiDAR.OcclusionRatio (LidarSourceOptions::occlusion_*),
 //   LiDAR.SurfaceFitWindowDeg (LidarSourceOptions::surface_fit_window_deg, 0 = off, default 0.5),
+//   LiDAR.SurfaceStepPx (LidarSourceOptions::surface_step_px, 1 .. 15, default 2),
 //   LiDAR.KernelFromRingSpacing (0/1, LidarSourceOptions::kernel_from_ring_spacing, default 1),
 //   LiDAR.RegistrationSigmaDeg (DepthNoiseModel::registration_sigma_deg, 0 = off, default 0.1),
 //   LiDAR.TimeOffset (SystemOptions::scan_time_offset: the image's time minus the scan's, seconds;
@@ -86,6 +87,7 @@ struct Settings {
   std::optional<double> occlusion_window_deg;  // LiDAR.OcclusionWindowDeg; unset = the source's default
   std::optional<double> occlusion_ratio;       // LiDAR.OcclusionRatio; unset = the source's default
   std::optional<double> surface_fit_window_deg;  // LiDAR.SurfaceFitWindowDeg; unset = the source's default (0.5)
+  std::optional<int> surface_step_px;            // LiDAR.SurfaceStepPx; unset = the source's default (2)
   std::optional<double> registration_sigma_deg;  // LiDAR.RegistrationSigmaDeg; unset = the model's default
   std::optional<double> scan_time_offset;      // LiDAR.TimeOffset, s; unset = the dataset's scan timestamps
   LoopClosingSettings loop_closing;
