@@ -105,7 +105,8 @@ struct SurfacePlaneFit {
 // through samples within step_px columns and 2 rows whose depths differ by at most surface_tolerance
 // (relative), so a road joins row by row and a background behind an edge stays out. Where a ring's
 // samples lie further apart along it than step_px, the surface stops at the first such gap: on a
-// grown kernel only the end that faces the camera is left (LidarSourceOptions::surface_step_px). Weights are 1 / max(distance, 0.5 px).
+// grown kernel only the end that faces the camera is left (LidarSourceOptions::surface_step_px).
+// Weights are 1 / max(distance, 0.5 px).
 // sample_distance_px is the nearest surface sample's distance; spread is as for lookup_depth. Pixels
 // outside the image get z = 0.
 // fit.rows > 0: z comes instead from a plane fitted, in inverse depth (affine in the pixel on a plane),
