@@ -2,7 +2,7 @@
 """The library's keypoint depth against the simulator's exact depth, by surface and by sample distance.
 
     PYTHONPATH=build/release/python scripts/keypoint_depth_truth.py SEQ [--every N] [--surface-step PX]
-        [--fixed-kernel] [--accumulate FULL_SEQ]
+        [--fixed-kernel] [--accumulate FULL_SEQ [--neighbours N] [--window PX]]
 
 SEQ: a simulator sequence whose depth/ folder holds camera 0's exact depth (`rgbl_sim --depth-camera 0`;
 a copy thinned by scripts/degrade.py --rings keeps it). Every N-th frame (default 5): rgbl's ORB
@@ -14,9 +14,10 @@ the ring plane fit placed, by the distance to the sample the value came from, an
 truth shows around the keypoint (inverse depth over +-3 px): level (changing down the image: the
 road), facade (changing across: a wall seen at an angle), frontal (neither) or other.
 --accumulate FULL_SEQ: a real drive instead (e.g. a KITTI sequence thinned by degrade.py --rings as
-SEQ, the original as FULL_SEQ), every 5th frame from the 5th: the truth is FULL_SEQ's scans of the 10
-neighbouring frames moved into the frame by the ground-truth poses, and the keypoint's ray met with a
-plane through their points that project within the 3 x 3 pixels around it (the nearest surface: within
+SEQ, the original as FULL_SEQ), every 5th frame from the 5th: the truth is FULL_SEQ's scans of the
+N frames either side (--neighbours, default 5) moved into the frame by the ground-truth poses, and the
+keypoint's ray met with a plane through their points that project within PX pixels of it (--window,
+default 1: 3 x 3 pixels) (the nearest surface: within
 3 % of their 10th-percentile depth; at least 8 points, within 3 cm of the plane, else no truth). So
 only keypoints on locally flat surfaces are graded, and the class is the plane's: level where its
 normal is within 26 deg of vertical. No z-buffer: a z-buffered image reads short wherever the depth
@@ -35,6 +36,8 @@ parser.add_argument("--every", type=int, default=5)
 parser.add_argument("--surface-step", type=int, default=2)
 parser.add_argument("--fixed-kernel", action="store_true")
 parser.add_argument("--accumulate", metavar="FULL_SEQ")
+parser.add_argument("--neighbours", type=int, default=5)
+parser.add_argument("--window", type=int, default=1)
 args = parser.parse_args()
 
 
@@ -47,7 +50,7 @@ class AccumulatedScans:
         self.width = shape[1]
         T_i = full.load(i).T_world_cam0
         clouds = []
-        for j in range(max(0, i - 5), min(len(full), i + 6)):
+        for j in range(max(0, i - args.neighbours), min(len(full), i + args.neighbours + 1)):
             if j == i:
                 continue
             other = full.load(j)
@@ -64,7 +67,8 @@ class AccumulatedScans:
 
     def plane_depth(self, x, y):
         """(depth where the ray through (x, y) meets the local plane, |normal's y|), or None"""
-        ids = [(int(y) + dy) * self.width + int(x) + dx for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+        r = range(-args.window, args.window + 1)
+        ids = [(int(y) + dy) * self.width + int(x) + dx for dy in r for dx in r]
         lo, hi = np.searchsorted(self.pixel, ids), np.searchsorted(self.pixel, ids, "right")
         q = self.points[np.concatenate([np.arange(a, b) for a, b in zip(lo, hi)])]
         if len(q) < 8:
@@ -93,7 +97,7 @@ for i in range(0, len(seq), args.every if full is None else 5):
     image = frame.images[0]
     if full is None:
         truth = rgbl.read_depth_png(f"{args.seq}/depth/{i:06d}.png")
-    elif 5 <= i < len(seq) - 5:
+    elif 5 <= i < len(seq) - 5:  # the same frames for any --neighbours up to 5
         scans = AccumulatedScans(full, i, seq.calibration.camera(0), image.shape)
     else:
         continue
