@@ -14,7 +14,7 @@ the ring plane fit placed, by the distance to the sample the value came from, an
 truth shows around the keypoint (inverse depth over +-3 px): level (changing down the image: the
 road), facade (changing across: a wall seen at an angle), frontal (neither) or other.
 --accumulate FULL_SEQ: a real drive instead (e.g. a KITTI sequence thinned by degrade.py --rings as
-SEQ, the original as FULL_SEQ), every 5th frame from the 5th: the truth is FULL_SEQ's scans of the
+SEQ, the original as FULL_SEQ), every N-th frame from the 5th to the 5th-last: the truth is FULL_SEQ's scans of the
 N frames either side (--neighbours, default 5) moved into the frame by the ground-truth poses, and the
 keypoint's ray met with a plane through their points that project within PX pixels of it (--window,
 default 1: 3 x 3 pixels) (the nearest surface: within
@@ -66,7 +66,7 @@ class AccumulatedScans:
         self.pixel, self.points = pixel[order], points[inside][order]
 
     def plane_depth(self, x, y):
-        """(depth where the ray through (x, y) meets the local plane, |normal's y|), or None"""
+        """(depth where the ray through (x, y) meets the local plane, the plane's class), or None"""
         r = range(-args.window, args.window + 1)
         ids = [(int(y) + dy) * self.width + int(x) + dx for dy in r for dx in r]
         lo, hi = np.searchsorted(self.pixel, ids), np.searchsorted(self.pixel, ids, "right")
@@ -83,24 +83,40 @@ class AccumulatedScans:
             return None
         ray = np.linalg.solve(self.K, np.array([x, y, 1.0]))
         depth = normal @ centre / (normal @ ray)
-        return (depth, abs(normal[1])) if depth > 0 else None
+        return (depth, "level" if abs(normal[1]) > 0.9 else "other") if depth > 0 else None
 
-seq = rgbl.open_sequence(args.seq)
-full = rgbl.open_sequence(args.accumulate) if args.accumulate else None
+
+def exact_surface(truth, u, v):
+    """the surface the simulator's exact depth shows around (u, v), from inverse depth over +-3 px"""
+    window = truth[max(v - 3, 0):v + 4, max(u - 3, 0):u + 4]
+    if window.shape != (7, 7) or not (window > 0).all():
+        return "other"
+    # relative change of inverse depth per pixel, across and down
+    du = abs(1 / truth[v, u + 3] - 1 / truth[v, u - 3]) / 6 * truth[v, u]
+    dv = abs(1 / truth[v + 3, u] - 1 / truth[v - 3, u]) / 6 * truth[v, u]
+    if dv > 3 * du and dv > 1e-4:
+        return "level"
+    if du > 3 * dv and du > 1e-4:
+        return "facade"
+    return "frontal" if du <= 1e-4 and dv <= 1e-4 else "other"
+
+
+camera0 = [True, False, False, False]  # the other cameras' images are not needed
+seq = rgbl.open_sequence(args.seq, cameras=camera0)
+full = rgbl.open_sequence(args.accumulate, cameras=camera0) if args.accumulate else None
 source = rgbl.make_lidar_source(seq.calibration.camera(0), surface_step_px=args.surface_step,
                                 kernel_from_ring_spacing=not args.fixed_kernel)
 orb = rgbl.OrbExtractor()
 
-rows = []
-for i in range(0, len(seq), args.every if full is None else 5):
+rows = []  # (estimate, truth, sample distance, gradient, surface)
+frames = range(0, len(seq), args.every) if full is None else range(5, len(seq) - 5, args.every)
+for i in frames:
     frame = seq.load(i)
     image = frame.images[0]
     if full is None:
         truth = rgbl.read_depth_png(f"{args.seq}/depth/{i:06d}.png")
-    elif 5 <= i < len(seq) - 5:  # the same frames for any --neighbours up to 5
-        scans = AccumulatedScans(full, i, seq.calibration.camera(0), image.shape)
     else:
-        continue
+        scans = AccumulatedScans(full, i, seq.calibration.camera(0), image.shape)
     source.prepare(image, scan=frame.scan, index=i, timestamp=frame.timestamp)
     keypoints, _ = orb.extract(image)
     pixels = np.stack([keypoints["x"], keypoints["y"]], 1).astype(np.float32)
@@ -109,28 +125,16 @@ for i in range(0, len(seq), args.every if full is None else 5):
             continue
         if full is not None:
             plane = scans.plane_depth(x, y)
-            if plane is not None:  # the plane's class in the level / facade columns
-                rows.append((z, plane[0], distance, gradient, 0.0 if plane[1] > 0.9 else np.nan,
-                             1.0 if plane[1] > 0.9 else np.nan))
+            if plane is not None:
+                rows.append((z, plane[0], distance, gradient, plane[1]))
             continue
         u, v = int(round(x)), int(round(y))
-        z_true = truth[v, u]
-        if not z_true > 0:
-            continue
-        window = truth[max(v - 3, 0):v + 4, max(u - 3, 0):u + 4]
-        if window.shape != (7, 7) or not (window > 0).all():
-            du = dv = np.nan
-        else:  # relative change of inverse depth per pixel, across and down
-            du = abs(1 / truth[v, u + 3] - 1 / truth[v, u - 3]) / 6 * truth[v, u]
-            dv = abs(1 / truth[v + 3, u] - 1 / truth[v - 3, u]) / 6 * truth[v, u]
-        rows.append((z, z_true, distance, gradient, du, dv))
+        if truth[v, u] > 0:
+            rows.append((z, truth[v, u], distance, gradient, exact_surface(truth, u, v)))
 
-a = np.array(rows)
+a = np.array([row[:4] for row in rows], np.float64)
+surface = np.array([row[4] for row in rows])
 error = (a[:, 0] - a[:, 1]) / a[:, 1]
-du, dv = a[:, 4], a[:, 5]
-level = (dv > 3 * du) & (dv > 1e-4)
-facade = (du > 3 * dv) & (du > 1e-4)
-frontal = (du <= 1e-4) & (dv <= 1e-4)
 
 
 def report(name, mask):
@@ -147,7 +151,5 @@ report("all", np.ones(len(a), bool))
 report("ring plane fit", a[:, 3] > 0)
 for lo, hi in [(0, 1.5), (1.5, 3), (3, 5), (5, 8), (8, 32)]:
     report(f"sample {lo}-{hi} px", (a[:, 2] >= lo) & (a[:, 2] < hi))
-report("level", level)
-report("facade", facade)
-report("frontal", frontal)
-report("other", ~(level | facade | frontal))
+for name in ("level", "facade", "frontal", "other"):
+    report(name, surface == name)

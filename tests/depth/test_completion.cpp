@@ -435,8 +435,9 @@ TEST_CASE("the occlusion filter equals the straightforward window scan, with one
 }
 
 TEST_CASE("ring spacing: the median gap between a scan's rings in the image") {
-  // rings as rows of samples every `spacing` px, each ring's samples 2 px apart along it (as on KITTI,
-  // so one column alone misses a ring half the time), offset by one column from ring to ring
+  // rings as rows of samples every `spacing` px, each ring's samples 2 px apart along it (so one column
+  // alone misses a ring half the time; on KITTI they lie 3 px apart within an image row), offset by one
+  // column from ring to ring
   const auto rings = [](int spacing, int first_row = 3) {
     cv::Mat_<float> sparse(300, 400, 0.0F);
     for (int r = first_row, k = 0; r < sparse.rows; r += spacing, ++k) {

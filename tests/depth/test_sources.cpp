@@ -422,7 +422,7 @@ TEST_CASE("lidar source: the kernel grows with the rings' spacing in the image, 
   context.calibration.camera.fx = context.calibration.camera.fy = 300.0;
   context.calibration.camera.cx = 400.0;
   context.calibration.camera.cy = 150.0;
-  context.calibration.camera.width = 800;  // 17 bands of ring_spacing_px
+  context.calibration.camera.width = 800;  // 26 bands of ring_spacing_px, every 31 columns
   context.calibration.camera.height = 300;
   const auto wall = [](int spacing) {
     std::vector<rgbl::LidarPoint> scan;

@@ -54,8 +54,9 @@ KernelShape parse_kernel_shape(std::string_view text, const char* key = "kernel.
 // The LiDAR's ring spacing where its scan lands in the image, in pixels: the median vertical gap
 // between consecutive samples (more than 1 px apart) in about 26 bands of 3 columns across the image (one
 // every 48 columns on KITTI's 1226 px; closer on narrower images, never further apart).
-// Every ring crosses a 3-column band; a single column would miss it half the time (a ring's samples are
-// about 2 px apart along it on KITTI). KITTI's HDL-64: 5-6 px; every second ring 10-11, every fourth 19-22.
+// Every ring crosses a 3-column band; a single column would miss most rings (a ring's samples lie 3 px
+// apart within an image row on KITTI, the median). KITTI's HDL-64: 5-6 px; every second ring 10-11, every
+// fourth 19-22.
 // std::nullopt with fewer than min_gaps gaps (an empty or nearly empty scan).
 std::optional<double> ring_spacing_px(const cv::Mat_<float>& sparse, std::size_t min_gaps = 100);
 
