@@ -69,6 +69,10 @@ void KeyframePairOptions::validate() const {
           "keyframe_pairs.odometry_sigma_translation", ">= 0 m (0 = off)");
   require(std::isfinite(odometry_sigma_rotation) && odometry_sigma_rotation >= 0.0,
           "keyframe_pairs.odometry_sigma_rotation", ">= 0 rad (0 = off)");
+  require(std::isfinite(lidar_sigma_translation) && lidar_sigma_translation >= 0.0,
+          "keyframe_pairs.lidar_sigma_translation", ">= 0 m (0 = off)");
+  require(std::isfinite(lidar_sigma_rotation) && lidar_sigma_rotation > 0.0, "keyframe_pairs.lidar_sigma_rotation",
+          "> 0 rad");
 }
 
 void add_keyframe_pairs(const Map& map, MapBundle& bundle, const KeyframePairOptions& options) {
@@ -109,6 +113,21 @@ void add_keyframe_pairs(const Map& map, MapBundle& bundle, const KeyframePairOpt
       pair.sigma_rotation = options.odometry_sigma_rotation;
       // a truck beside the car lifted tracked steps by 0.2-0.3 m; the road planes agree within 0.05 m
       pair.level_only = kf->road && map.keyframe(kf->previous)->road;
+      bundle.problem.pose_pairs.push_back(pair);
+    }
+  }
+  if (options.lidar_sigma_translation > 0.0) {
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      const Keyframe* kf = map.keyframe(bundle.keyframes[i]);
+      if (poses[i].fixed || kf == nullptr || !kf->previous.valid() || !kf->T_cam_previous_lidar) continue;
+      const auto previous = std::find(bundle.keyframes.begin(), bundle.keyframes.end(), kf->previous);
+      if (previous == bundle.keyframes.end()) continue;
+      BundlePosePair pair;
+      pair.pose_a = static_cast<int>(previous - bundle.keyframes.begin());
+      pair.pose_b = static_cast<int>(i);
+      pair.T_b_a = *kf->T_cam_previous_lidar;
+      pair.sigma_translation = options.lidar_sigma_translation;
+      pair.sigma_rotation = options.lidar_sigma_rotation;
       bundle.problem.pose_pairs.push_back(pair);
     }
   }

@@ -401,6 +401,9 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.loop_closing.bridge = flag("LoopClosing.BridgeGaps");
   s.loop_closing.bridge_max_gap_s = r.number({"LoopClosing.BridgeMaxGap"});
   s.place_culling = flag("LocalMapping.PlaceCulling");
+  s.lidar_pair_sigma = r.number({"LocalMapping.LidarPairSigma"});
+  if (s.lidar_pair_sigma && !(*s.lidar_pair_sigma >= 0.0 && *s.lidar_pair_sigma <= 1.0))
+    r.fail("LocalMapping.LidarPairSigma", "a sigma from 0 (off) to 1 m");
   s.reference_landmark_ratio = r.number({"Tracking.ReferenceLandmarkRatio"});
   if (s.reference_landmark_ratio && !(*s.reference_landmark_ratio >= 0.0 && *s.reference_landmark_ratio <= 1.0))
     r.fail("Tracking.ReferenceLandmarkRatio", "a share from 0 (off) to 1");

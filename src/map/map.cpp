@@ -119,6 +119,11 @@ void Map::erase_keyframe(KeyframeId keyframe_id) {
     if (slot && slot->previous == keyframe_id) {
       slot->previous = k->previous;
       slot->T_cam_previous = slot->T_cam_previous * k->T_cam_previous;
+      if (slot->T_cam_previous_lidar && k->T_cam_previous_lidar) {
+        slot->T_cam_previous_lidar = *slot->T_cam_previous_lidar * *k->T_cam_previous_lidar;
+      } else {
+        slot->T_cam_previous_lidar.reset();
+      }
     }
     if (!slot || slot->parent != keyframe_id) continue;
     KeyframeId best = new_parent;

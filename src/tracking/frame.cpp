@@ -103,6 +103,10 @@ void LocalMappingOptions::validate() const {
           ">= 2 (the place's first keyframe and the new one)");
   fusion_match.validate();
   ba.validate();
+  lidar_registration.validate();
+  require(lidar_min_probe_loss >= 0.0 && lidar_min_probe_loss < 1.0, "local_mapping.lidar_min_probe_loss", "in [0, 1)");
+  require(lidar_max_change_m > 0.0, "local_mapping.lidar_max_change_m", "> 0 m");
+  require(lidar_max_change_deg > 0.0, "local_mapping.lidar_max_change_deg", "> 0 deg");
 }
 
 }  // namespace rgbl

@@ -1,8 +1,12 @@
 #include "rgbl/tracking/local_mapping.hpp"
 
 #include "rgbl/backend/map_bundle.hpp"
+#include "rgbl/core/log.hpp"
 #include "rgbl/core/timer.hpp"
+#include "rgbl/geometry/scan_registration.hpp"
 #include "rgbl/map/fusion.hpp"
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -35,6 +39,7 @@ LocalMappingStats LocalMapper::process(KeyframeId keyframe, const std::vector<La
     stats.new_landmarks = static_cast<int>(created_with_keyframe.size() + created.size());
     if (options_.fusion) stats.fused_landmarks = fuse(keyframe);
   }
+  if (options_.pairs.lidar_sigma_translation > 0.0) measure_lidar_pair(keyframe);
   if (options_.local_ba) stats.ba_outliers = local_bundle_adjustment(keyframe, stats.ba_ms);
   if (options_.keyframe_culling) {
     std::unique_lock lock(map_.mutex());
@@ -45,6 +50,59 @@ LocalMappingStats LocalMapper::process(KeyframeId keyframe, const std::vector<La
     }
   }
   return stats;
+}
+
+namespace {
+
+std::vector<LidarPoint> as_points(const ScanSample& sample) {
+  std::vector<LidarPoint> points(sample.points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    points[i].x = sample.points[i].x();
+    points[i].y = sample.points[i].y();
+    points[i].z = sample.points[i].z();
+  }
+  return points;
+}
+
+}  // namespace
+
+void LocalMapper::measure_lidar_pair(KeyframeId id) {
+  std::shared_ptr<const ScanSample> scan, previous_scan;
+  Eigen::Isometry3d T_cam_previous = Eigen::Isometry3d::Identity();
+  {
+    std::shared_lock lock(map_.mutex());
+    const Keyframe* kf = map_.keyframe(id);
+    const Keyframe* previous = kf != nullptr && kf->previous.valid() ? map_.keyframe(kf->previous) : nullptr;
+    if (previous == nullptr || !kf->scan || !previous->scan) return;
+    scan = kf->scan;
+    previous_scan = previous->scan;
+    T_cam_previous = kf->T_cam_previous;
+  }
+  // both samples are in their camera frames: the registration is between the cameras
+  Stopwatch watch;
+  const std::vector<LidarPoint> reference = as_points(*previous_scan), query = as_points(*scan);
+  const auto r = register_scans(reference, query, T_cam_previous.inverse(), options_.lidar_registration);
+  const double ms = watch.elapsed_ms();
+  if (!r || !r->converged || r->min_probe_loss <= options_.lidar_min_probe_loss) {
+    logger()->debug("keyframe {}: LiDAR pair not kept ({})", id.value,
+                    !r ? "too little to register"
+                       : !r->converged ? "not converged"
+                                       : fmt::format("not pinned down: probe loss {:.3f}", r->min_probe_loss));
+    return;
+  }
+  const Eigen::Isometry3d measured = r->T_reference_query.inverse();
+  const Eigen::Isometry3d change = measured * T_cam_previous.inverse();
+  const double change_deg = Eigen::AngleAxisd(change.linear()).angle() * 180.0 / std::numbers::pi;
+  logger()->debug("keyframe {}: LiDAR pair {:.3f} m, {:.3f} deg from the tracked step of {:.3f} m (its own {:.3f} m; "
+                  "probe loss {:.4f}; {} and {} points, {:.1f} ms)",
+                  id.value, change.translation().norm(), change_deg, T_cam_previous.translation().norm(),
+                  measured.translation().norm(), r->min_probe_loss, reference.size(), query.size(), ms);
+  if (change.translation().norm() > options_.lidar_max_change_m || change_deg > options_.lidar_max_change_deg) return;
+  std::unique_lock lock(map_.mutex());
+  // the previous keyframe may have been erased meanwhile (its motion handed on): then this is stale
+  if (Keyframe* kf = map_.keyframe(id); kf != nullptr && kf->T_cam_previous.isApprox(T_cam_previous)) {
+    kf->T_cam_previous_lidar = measured;
+  }
 }
 
 void LocalMapper::watch_initial(KeyframeId id) {

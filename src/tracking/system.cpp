@@ -272,16 +272,24 @@ double System::scan_age(const SensorFrame& sensor) const {
   return sensor.scan_timestamp ? sensor.timestamp - *sensor.scan_timestamp : 0.0;
 }
 
-Eigen::Isometry3d System::scan_motion(const SensorFrame& sensor) const {
-  const Impl& s = *impl_;
-  const double age = scan_age(sensor);
-  const auto& velocity = s.tracker.velocity();
-  const double dt = s.tracker.velocity_dt();
+namespace {
+
+// The motion from a scan `age` seconds older than its image to the image, from the tracker's velocity;
+// none where that is unknown (no velocity yet, no pose) or the age is 0 or a glitch.
+std::optional<Eigen::Isometry3d> known_scan_motion(double age, const Tracker& tracker) {
+  const auto& velocity = tracker.velocity();
+  const double dt = tracker.velocity_dt();
   // a scan time set by hand (Python) may be a glitch too: no motion rather than a wrong one
-  if (age == 0.0 || !(std::abs(age) <= kMaxScanAge) || !has_pose(s.tracker.state()) || !velocity || !(dt > 0.0)) {
-    return Eigen::Isometry3d::Identity();
+  if (age == 0.0 || !(std::abs(age) <= kMaxScanAge) || !has_pose(tracker.state()) || !velocity || !(dt > 0.0)) {
+    return std::nullopt;
   }
   return se3_exp(se3_log(*velocity) * (age / dt));
+}
+
+}  // namespace
+
+Eigen::Isometry3d System::scan_motion(const SensorFrame& sensor) const {
+  return known_scan_motion(scan_age(sensor), impl_->tracker).value_or(Eigen::Isometry3d::Identity());
 }
 
 TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
@@ -296,7 +304,11 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   const int with_depth = prepared.keypoints_with_depth;
   result.timing.extraction_ms = prepared.extraction_ms;
   result.timing.depth_ms = prepared.depth_ms;
-  if (!sensor.scan.empty()) result.scan_age = scan_age(sensor);
+  if (!sensor.scan.empty()) {
+    result.scan_age = scan_age(sensor);
+    // the same test as scan_motion's, on the same tracker state: before this frame is tracked
+    frame.scan_at_image_time = result.scan_age == 0.0 || known_scan_motion(result.scan_age, s.tracker).has_value();
+  }
 
   // A loop thread's correction waits for this frame to be tracked and recorded (uncontended inline).
   const std::lock_guard gate(s.tracking_gate);

@@ -32,6 +32,7 @@ Keyframe keyframe_from(const Frame& frame, const TrackerOptions& options) {
   kf.descriptors = frame.descriptors;
   kf.depth = frame.depth;
   kf.depth_sigma = frame.depth_sigma;
+  if (frame.scan_at_image_time) kf.scan = frame.scan;
   // the road under it, which ties it to the keyframes before it in local BA
   if (frame.scan) {
     if (const auto road = road_plane(*frame.scan, options)) kf.road = Eigen::Vector4d(road->n.x(), road->n.y(), road->n.z(), road->d);

@@ -158,6 +158,26 @@ TEST_CASE("map bundle: keyframe pairs join each optimised keyframe to the road b
   CHECK(motions[0].T_b_a.isApprox(map.keyframe(keyframes[3])->T_cam_previous));
   CHECK(motions[0].sigma_translation == options.odometry_sigma_translation);
 
+  // the LiDAR pair: where a keyframe holds its scans' motion, one more pair with it, all six axes,
+  // whatever the road; none with its sigma 0
+  const Eigen::Isometry3d lidar_motion = Eigen::Translation3d(0.01, 0.0, -0.98) * map.keyframe(keyframes[1])->T_cam_previous;
+  map.keyframe(keyframes[1])->T_cam_previous_lidar = lidar_motion;
+  options.lidar_sigma_translation = 0.0;
+  bundle = rgbl::make_map_bundle(map, window, anchors);
+  rgbl::add_keyframe_pairs(map, bundle, options);
+  CHECK(bundle.problem.pose_pairs.size() == 3);
+  options.lidar_sigma_translation = 0.02;
+  bundle = rgbl::make_map_bundle(map, window, anchors);
+  rgbl::add_keyframe_pairs(map, bundle, options);
+  REQUIRE(bundle.problem.pose_pairs.size() == 4);
+  const rgbl::BundlePosePair& lidar = bundle.problem.pose_pairs.back();
+  CHECK((lidar.pose_a == 3 && lidar.pose_b == 1 && !lidar.level_only));
+  CHECK(lidar.T_b_a.isApprox(lidar_motion));
+  CHECK(lidar.sigma_translation == 0.02);
+  CHECK(lidar.sigma_rotation == options.lidar_sigma_rotation);
+  map.keyframe(keyframes[1])->T_cam_previous_lidar.reset();
+  options.lidar_sigma_translation = 0.0;
+
   // a previous keyframe outside the problem, a road too far away, or a sigma of 0: no pair
   bundle = rgbl::make_map_bundle(map, std::vector<rgbl::KeyframeId>{keyframes[2]}, std::vector<rgbl::KeyframeId>{keyframes[0]});
   options.road_max_distance = 0.9;  // keyframe 0 is 1 m behind keyframe 2
@@ -184,6 +204,12 @@ TEST_CASE("keyframe pair options are checked, naming the field, and 0 turns a pa
   o = {};
   o.odometry_sigma_rotation = std::numeric_limits<double>::infinity();
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("keyframe_pairs.odometry_sigma_rotation"));
+  o = {};
+  o.lidar_sigma_translation = -0.02;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("keyframe_pairs.lidar_sigma_translation"));
+  o = {};
+  o.lidar_sigma_rotation = 0.0;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("keyframe_pairs.lidar_sigma_rotation"));
   o = {};
   o.road_sigma_offset = 0.0;
   o.odometry_sigma_translation = 0.0;

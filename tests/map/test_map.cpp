@@ -139,17 +139,38 @@ TEST_CASE("map: erasing a keyframe carries the motion measured into it on to the
   kb.T_cam_previous = Eigen::Isometry3d(Eigen::Translation3d(0.1, 0.0, -1.0)) *
                       Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitY());
   const Eigen::Isometry3d T_b_a = kb.T_cam_previous;
+  kb.T_cam_previous_lidar = Eigen::Translation3d(0.0, 0.0, 0.01) * T_b_a;  // the scans' own measure
+  const Eigen::Isometry3d T_b_a_lidar = *kb.T_cam_previous_lidar;
   const auto b = map.add_keyframe(std::move(kb));
   rgbl::Keyframe kc = make_keyframe(2.0, 4);
   kc.previous = b;
   kc.T_cam_previous = Eigen::Isometry3d(Eigen::Translation3d(-0.05, 0.01, -1.2)) *
                       Eigen::AngleAxisd(-0.03, Eigen::Vector3d::UnitY());
   const Eigen::Isometry3d T_c_b = kc.T_cam_previous;
+  kc.T_cam_previous_lidar = Eigen::Translation3d(0.0, 0.0, -0.01) * T_c_b;
+  const Eigen::Isometry3d T_c_b_lidar = *kc.T_cam_previous_lidar;
   const auto c = map.add_keyframe(std::move(kc));
   CHECK(map.keyframe(c)->previous == b);
   map.erase_keyframe(b);
   CHECK(map.keyframe(c)->previous == a);
   CHECK(map.keyframe(c)->T_cam_previous.isApprox(T_c_b * T_b_a, 1e-12));
+  REQUIRE(map.keyframe(c)->T_cam_previous_lidar);
+  CHECK(map.keyframe(c)->T_cam_previous_lidar->isApprox(T_c_b_lidar * T_b_a_lidar, 1e-12));
   map.erase_keyframe(a);  // a map's first has none before it: nor has c now
   CHECK_FALSE(map.keyframe(c)->previous.valid());
+}
+
+TEST_CASE("map: erasing a keyframe drops the scans' motion after it when its own was not measured") {
+  rgbl::Map map;
+  const auto a = map.add_keyframe(make_keyframe(0.0, 4));
+  rgbl::Keyframe kb = make_keyframe(1.0, 4);
+  kb.previous = a;  // its scans were not registered (no clear optimum)
+  const auto b = map.add_keyframe(std::move(kb));
+  rgbl::Keyframe kc = make_keyframe(2.0, 4);
+  kc.previous = b;
+  kc.T_cam_previous_lidar = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, -1.0));
+  const auto c = map.add_keyframe(std::move(kc));
+  map.erase_keyframe(b);
+  CHECK(map.keyframe(c)->previous == a);
+  CHECK_FALSE(map.keyframe(c)->T_cam_previous_lidar);
 }

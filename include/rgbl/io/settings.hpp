@@ -22,7 +22,8 @@
 //   Tracking.RegisterLost (0/1, TrackerOptions::register_lost: a lost frame placed by its scan),
 //   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
 //   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1), MergeMaps (0/1) (LoopClosingOptions' fields of those
-//   names).
+//   names), LocalMapping.PlaceCulling (0/1), LocalMapping.LidarPairSigma (m, 0 = off, default 0.02:
+//   KeyframePairOptions::lidar_sigma_translation, keyframes tied by their scans' registration).
 // Viewer.* and other display-only ORB-SLAM keys are accepted and ignored without a warning.
 
 #include "rgbl/geometry/camera.hpp"
@@ -92,6 +93,8 @@ struct Settings {
   std::optional<double> scan_time_offset;      // LiDAR.TimeOffset, s; unset = the dataset's scan timestamps
   LoopClosingSettings loop_closing;
   std::optional<bool> place_culling;  // LocalMapping.PlaceCulling: keyframe culling by revisits
+  // LocalMapping.LidarPairSigma: KeyframePairOptions::lidar_sigma_translation (m, 0 = off)
+  std::optional<double> lidar_pair_sigma;
   std::optional<double> reference_landmark_ratio;  // Tracking.ReferenceLandmarkRatio
   std::optional<bool> bounded_depth_error;          // Tracking.BoundedDepthError
   std::optional<bool> register_gaps;                // Tracking.RegisterGaps

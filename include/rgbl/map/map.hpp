@@ -8,6 +8,7 @@
 // erased (storage is a deque), but must not be used after the lock that guarded the look-up is gone.
 
 #include "rgbl/features/types.hpp"
+#include "rgbl/geometry/scan_agreement.hpp"
 #include "rgbl/geometry/se3.hpp"
 
 #include <Eigen/Core>
@@ -17,6 +18,7 @@
 #include <cstddef>
 #include <deque>
 #include <map>
+#include <memory>
 #include <optional>
 #include <shared_mutex>
 #include <span>
@@ -54,6 +56,13 @@ struct Keyframe {
   // map's first. Erasing the previous one hands over its own previous, the motions composed.
   KeyframeId previous;
   Eigen::Isometry3d T_cam_previous = Eigen::Isometry3d::Identity();
+  // A subsample of its LiDAR scan in its camera frame (null without a scan), and the motion from
+  // `previous` that its scan registered onto the previous one's measures (none until local mapping
+  // measured it, or when the registration was not a clear optimum): local BA keeps to it too
+  // (KeyframePairOptions::lidar_sigma_translation). Composed like T_cam_previous when a keyframe
+  // between is erased.
+  std::shared_ptr<const ScanSample> scan;
+  std::optional<Eigen::Isometry3d> T_cam_previous_lidar;
 
   Eigen::Vector3d center() const { return T_cam_world.inverse().translation(); }
   int landmark_count() const;

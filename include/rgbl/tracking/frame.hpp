@@ -47,6 +47,10 @@ struct Frame {
   // A subsample of the frame's LiDAR scan in its camera frame (null without a scan): a second
   // opinion on poses that the images leave ambiguous. Shared, so copies of the frame are cheap.
   std::shared_ptr<const ScanSample> scan;
+  // False when the scan was taken apart from the image and no known motion could move it to the
+  // image's time (a map's first frame: no velocity yet): its points are off by the distance driven in
+  // between (0.17 m at KITTI's 17 ms and 10 m/s), too much to measure a keyframe's motion with.
+  bool scan_at_image_time = true;
   FeatureGrid grid;  // radius queries over keypoints; rebuild after changing them
 
   std::size_t size() const { return keypoints.size(); }

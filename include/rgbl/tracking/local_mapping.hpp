@@ -53,6 +53,10 @@ class LocalMapper {
   void associate(KeyframeId keyframe);
   int cull_landmarks(KeyframeId keyframe);
   int fuse(KeyframeId keyframe);
+  // Registers the keyframe's scan onto its previous keyframe's and keeps the motion as
+  // Keyframe::T_cam_previous_lidar where it is a clear optimum near the tracked motion (only with
+  // the LiDAR pair on). Takes the map lock itself; registers without it.
+  void measure_lidar_pair(KeyframeId keyframe);
   int local_bundle_adjustment(KeyframeId keyframe, double& elapsed_ms);
   int cull_keyframes(KeyframeId keyframe);
   int cull_revisited(KeyframeId keyframe);

@@ -215,6 +215,22 @@ struct LocalMappingOptions {
   int max_local_ba_keyframes = 10;      // optimised keyframes (the current one and its best covisible)
   int max_fixed_keyframes = 20;
   KeyframePairOptions pairs;            // the road and the tracked motion between keyframes
+  // The LiDAR pair's registration (pairs.lidar_sigma_translation > 0): two keyframes a few metres
+  // apart, from the tracked motion, which is within centimetres; their scans are the frames' samples
+  // (every 8th return within 2-40 m, at the image's time). Kept where it is pinned down along every
+  // axis, however little (registration.probe_shift_m moved along an axis loses more than
+  // lidar_min_probe_loss of the points that land: a corridor loses nothing, and the pair would only
+  // restate tracking's step along it; the simulator's hedge streets lose 0.001-0.05, yet their few
+  // trunks place the scans within 0.02 m of the truth), and within lidar_max_change_m /
+  // lidar_max_change_deg of the tracked motion (3 sigmas of the tracked motion's own pair): beyond
+  // that a truck driving beside the car has pulled it (docs/accuracy.md, "Keyframes tied by their
+  // scans").
+  ScanRegistrationOptions lidar_registration{.min_range = 2.0, .max_range = 40.0, .reference_voxel = 0.3,
+                                             .query_voxel = 0.3, .coarse_distance = 0.5, .coarse_iterations = 3,
+                                             .fine_distance = 0.3, .robust_scale = 0.1};
+  double lidar_min_probe_loss = 0.0;
+  double lidar_max_change_m = 0.3;
+  double lidar_max_change_deg = 1.0;
   double min_found_ratio = 0.25;        // landmark culling
   int min_observations = 3;             // landmark culling after 2 keyframes
   double redundant_ratio = 0.9;         // keyframe culling
