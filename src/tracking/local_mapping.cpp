@@ -39,7 +39,12 @@ LocalMappingStats LocalMapper::process(KeyframeId keyframe, const std::vector<La
     stats.new_landmarks = static_cast<int>(created_with_keyframe.size() + created.size());
     if (options_.fusion) stats.fused_landmarks = fuse(keyframe);
   }
-  if (options_.pairs.lidar_sigma_translation > 0.0) measure_lidar_pair(keyframe);
+  if (options_.pairs.lidar_sigma_translation > 0.0) {
+    measure_lidar_pair(keyframe);
+  } else {
+    std::unique_lock lock(map_.mutex());
+    if (Keyframe* kf = map_.keyframe(keyframe)) kf->scan.reset();
+  }
   if (options_.local_ba) stats.ba_outliers = local_bundle_adjustment(keyframe, stats.ba_ms);
   if (options_.keyframe_culling) {
     std::unique_lock lock(map_.mutex());
@@ -70,12 +75,17 @@ void LocalMapper::measure_lidar_pair(KeyframeId id) {
   std::shared_ptr<const ScanSample> scan, previous_scan;
   Eigen::Isometry3d T_cam_previous = Eigen::Isometry3d::Identity();
   {
-    std::shared_lock lock(map_.mutex());
-    const Keyframe* kf = map_.keyframe(id);
-    const Keyframe* previous = kf != nullptr && kf->previous.valid() ? map_.keyframe(kf->previous) : nullptr;
-    if (previous == nullptr || !kf->scan || !previous->scan) return;
+    // A keyframe's scan is needed until the next keyframe is registered onto it, no longer: the
+    // previous one's is handed over here (a KITTI sample is ~170 KB; thousands of keyframes on a long
+    // drive). Erasing a keyframe composes the measured motions, it does not register again.
+    std::unique_lock lock(map_.mutex());
+    Keyframe* kf = map_.keyframe(id);
+    Keyframe* previous = kf != nullptr && kf->previous.valid() ? map_.keyframe(kf->previous) : nullptr;
+    if (previous == nullptr) return;
+    previous_scan = std::move(previous->scan);
+    previous->scan.reset();
+    if (!kf->scan || !previous_scan) return;
     scan = kf->scan;
-    previous_scan = previous->scan;
     T_cam_previous = kf->T_cam_previous;
   }
   // both samples are in their camera frames: the registration is between the cameras

@@ -263,6 +263,9 @@ std::pair<std::optional<Eigen::Isometry3d>, Eigen::Isometry3d> lidar_pair(bool l
   camera.height = 370;
   rgbl::LocalMapper mapper(map, camera, options);
   mapper.process(id_b);
+  // the previous keyframe's scan is released once the new one is registered onto it, the new one's kept
+  CHECK_FALSE(map.keyframe(id_a)->scan);
+  CHECK(map.keyframe(id_b)->scan);
   return {map.keyframe(id_b)->T_cam_previous_lidar, T_b_a};
 }
 

@@ -56,9 +56,10 @@ struct Keyframe {
   // map's first. Erasing the previous one hands over its own previous, the motions composed.
   KeyframeId previous;
   Eigen::Isometry3d T_cam_previous = Eigen::Isometry3d::Identity();
-  // A subsample of its LiDAR scan in its camera frame (null without a scan), and the motion from
-  // `previous` that its scan registered onto the previous one's measures (none until local mapping
-  // measured it, or when the registration was not a clear optimum): local BA keeps to it too
+  // A subsample of its LiDAR scan in its camera frame (null without a scan; local mapping releases it
+  // once the next keyframe is registered onto it), and the motion from `previous` that its scan
+  // registered onto the previous one's measures (none until local mapping measured it, or when the
+  // registration was not a clear optimum): local BA keeps to it too
   // (KeyframePairOptions::lidar_sigma_translation). Composed like T_cam_previous when a keyframe
   // between is erased.
   std::shared_ptr<const ScanSample> scan;
