@@ -99,37 +99,32 @@ void add_keyframe_pairs(const Map& map, MapBundle& bundle, const KeyframePairOpt
       bundle.problem.plane_pairs.push_back(pair);
     }
   }
-  if (options.odometry_sigma_translation > 0.0 && options.odometry_sigma_rotation > 0.0) {
+  // Each optimised keyframe whose previous keyframe is in the problem: the keyframe and the two poses.
+  const auto for_each_with_previous = [&](auto&& add) {
     for (std::size_t i = 0; i < poses.size(); ++i) {
       const Keyframe* kf = map.keyframe(bundle.keyframes[i]);
       if (poses[i].fixed || kf == nullptr || !kf->previous.valid()) continue;
       const auto previous = std::find(bundle.keyframes.begin(), bundle.keyframes.end(), kf->previous);
-      if (previous == bundle.keyframes.end()) continue;
-      BundlePosePair pair;
-      pair.pose_a = static_cast<int>(previous - bundle.keyframes.begin());
-      pair.pose_b = static_cast<int>(i);
-      pair.T_b_a = kf->T_cam_previous;
-      pair.sigma_translation = options.odometry_sigma_translation;
-      pair.sigma_rotation = options.odometry_sigma_rotation;
-      // a truck beside the car lifted tracked steps by 0.2-0.3 m; the road planes agree within 0.05 m
-      pair.level_only = kf->road && map.keyframe(kf->previous)->road;
-      bundle.problem.pose_pairs.push_back(pair);
+      if (previous != bundle.keyframes.end()) add(*kf, static_cast<int>(previous - bundle.keyframes.begin()), static_cast<int>(i));
     }
+  };
+  if (options.odometry_sigma_translation > 0.0 && options.odometry_sigma_rotation > 0.0) {
+    for_each_with_previous([&](const Keyframe& kf, int a, int b) {
+      bundle.problem.pose_pairs.push_back({.pose_a = a, .pose_b = b, .T_b_a = kf.T_cam_previous,
+                                           .sigma_translation = options.odometry_sigma_translation,
+                                           .sigma_rotation = options.odometry_sigma_rotation,
+                                           // a truck beside the car lifted tracked steps by 0.2-0.3 m; the
+                                           // road planes agree within 0.05 m
+                                           .level_only = kf.road && map.keyframe(kf.previous)->road});
+    });
   }
   if (options.lidar_sigma_translation > 0.0) {
-    for (std::size_t i = 0; i < poses.size(); ++i) {
-      const Keyframe* kf = map.keyframe(bundle.keyframes[i]);
-      if (poses[i].fixed || kf == nullptr || !kf->previous.valid() || !kf->T_cam_previous_lidar) continue;
-      const auto previous = std::find(bundle.keyframes.begin(), bundle.keyframes.end(), kf->previous);
-      if (previous == bundle.keyframes.end()) continue;
-      BundlePosePair pair;
-      pair.pose_a = static_cast<int>(previous - bundle.keyframes.begin());
-      pair.pose_b = static_cast<int>(i);
-      pair.T_b_a = *kf->T_cam_previous_lidar;
-      pair.sigma_translation = options.lidar_sigma_translation;
-      pair.sigma_rotation = options.lidar_sigma_rotation;
-      bundle.problem.pose_pairs.push_back(pair);
-    }
+    for_each_with_previous([&](const Keyframe& kf, int a, int b) {
+      if (!kf.T_cam_previous_lidar) return;
+      bundle.problem.pose_pairs.push_back({.pose_a = a, .pose_b = b, .T_b_a = *kf.T_cam_previous_lidar,
+                                           .sigma_translation = options.lidar_sigma_translation,
+                                           .sigma_rotation = options.lidar_sigma_rotation});
+    });
   }
 }
 
