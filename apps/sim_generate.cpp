@@ -44,6 +44,12 @@ int main(int argc, char** argv) {
   app.add_option("--image-noise", o.image_noise_sigma, "image noise sigma, grey levels")->capture_default_str();
   app.add_option("--lidar-noise", o.lidar.range_noise_sigma, "LiDAR range noise sigma, m")->capture_default_str();
   app.add_option("--lidar-dropout", o.lidar.dropout, "probability of a missing LiDAR return")->capture_default_str();
+  app.add_option("--lidar-elevation-offset", o.lidar.elevation_offset_deg,
+                 "error of every LiDAR beam's elevation, deg (the points keep the nominal one)")
+      ->capture_default_str();
+  app.add_option("--lidar-beam-error", o.lidar.beam_elevation_sigma_deg,
+                 "sigma of each LiDAR beam's own elevation error, deg (drawn once per beam and seed)")
+      ->capture_default_str();
   app.add_option("--depth-camera", o.depth_camera, "camera of the exact depth images (0..3)")->capture_default_str();
   app.add_option("--untextured", untextured, "FIRST LAST: frames rendered with plain surfaces")->expected(2);
   app.add_option("--drop-scan", o.dropped_scans, "frames with an empty LiDAR scan")->expected(1, 1000000);
@@ -74,6 +80,8 @@ int main(int argc, char** argv) {
       if (app.count("--image-noise") > 0) o.image_noise_sigma = given.image_noise_sigma;
       if (app.count("--lidar-noise") > 0) o.lidar.range_noise_sigma = given.lidar.range_noise_sigma;
       if (app.count("--lidar-dropout") > 0) o.lidar.dropout = given.lidar.dropout;
+      if (app.count("--lidar-elevation-offset") > 0) o.lidar.elevation_offset_deg = given.lidar.elevation_offset_deg;
+      if (app.count("--lidar-beam-error") > 0) o.lidar.beam_elevation_sigma_deg = given.lidar.beam_elevation_sigma_deg;
       if (app.count("--depth-camera") > 0) o.depth_camera = given.depth_camera;
       if (app.count("--threads") > 0) o.threads = given.threads;
       o.dropped_scans = given.dropped_scans;

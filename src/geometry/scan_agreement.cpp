@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 
 namespace rgbl {
@@ -13,6 +14,8 @@ void ScanSampleOptions::validate() const {
   require(std::isfinite(min_range) && min_range >= 0.0, "scan_sample.min_range", ">= 0 m");
   require(std::isfinite(max_range) && max_range > min_range, "scan_sample.max_range", "finite and > min_range");
   require(std::isfinite(tolerance) && tolerance > 0.0, "scan_sample.tolerance", "> 0 m");
+  require(std::isfinite(elevation_correction_deg) && std::abs(elevation_correction_deg) <= 2.0,
+          "scan_sample.elevation_correction_deg", "an angle in [-2, 2] deg");
 }
 
 ScanSample sample_scan(PointCloudView scan, const Eigen::Isometry3d& T_cam_lidar, const ScanSampleOptions& options) {
@@ -21,10 +24,20 @@ ScanSample sample_scan(PointCloudView scan, const Eigen::Isometry3d& T_cam_lidar
   const auto max2 = static_cast<float>(options.max_range * options.max_range);
   const Eigen::Isometry3f T = T_cam_lidar.cast<float>();
   sample.points.reserve(scan.size() / options.stride + 1);
+  // turning up by a about p x z rotates (horizontal distance h, height z) by a in its own vertical plane
+  const double a = options.elevation_correction_deg * std::numbers::pi / 180.0;
+  const auto ca = static_cast<float>(std::cos(a)), sa = static_cast<float>(std::sin(a));
   for (std::size_t i = 0; i < scan.size(); i += options.stride) {
-    const Eigen::Vector3f p(scan[i].x, scan[i].y, scan[i].z);
+    Eigen::Vector3f p(scan[i].x, scan[i].y, scan[i].z);
     const float r2 = p.squaredNorm();
     if (!(r2 >= min2 && r2 <= max2)) continue;  // also drops NaN
+    if (a != 0.0) {
+      const float h = std::hypot(p.x(), p.y());
+      if (h > 0.0F) {
+        const float h_turned = h * ca - p.z() * sa, scale = h_turned / h;
+        p = Eigen::Vector3f(p.x() * scale, p.y() * scale, h * sa + p.z() * ca);
+      }
+    }
     sample.points.push_back(T * p);
   }
   return sample;

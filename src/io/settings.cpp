@@ -365,6 +365,10 @@ Settings read_settings(const std::filesystem::path& yaml) {
     if (!(*v >= 0.0 && *v < 5.0)) r.fail("LiDAR.RegistrationSigmaDeg", "0 (off) .. 5 deg");
     s.registration_sigma_deg = *v;
   }
+  if (const auto v = r.number({"LiDAR.ElevationCorrection"})) {
+    if (!(std::abs(*v) <= 2.0)) r.fail("LiDAR.ElevationCorrection", "an angle in deg, -2 .. 2");
+    s.elevation_correction_deg = *v;
+  }
   if (const auto v = r.number({"LiDAR.TimeOffset"})) {
     if (!(std::abs(*v) <= kMaxScanAge)) r.fail("LiDAR.TimeOffset", kScanAgeExpected);
     s.scan_time_offset = *v;
@@ -404,6 +408,9 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.lidar_pair_sigma = r.number({"LocalMapping.LidarPairSigma"});
   if (s.lidar_pair_sigma && !(*s.lidar_pair_sigma >= 0.0 && *s.lidar_pair_sigma <= 1.0))
     r.fail("LocalMapping.LidarPairSigma", "a sigma from 0 (off) to 1 m");
+  s.lidar_pair_sigma_rotation = r.number({"LocalMapping.LidarPairSigmaRotation"});
+  if (s.lidar_pair_sigma_rotation && !(*s.lidar_pair_sigma_rotation > 0.0 && *s.lidar_pair_sigma_rotation <= 0.1))
+    r.fail("LocalMapping.LidarPairSigmaRotation", "a sigma above 0 and at most 0.1 rad");
   s.reference_landmark_ratio = r.number({"Tracking.ReferenceLandmarkRatio"});
   if (s.reference_landmark_ratio && !(*s.reference_landmark_ratio >= 0.0 && *s.reference_landmark_ratio <= 1.0))
     r.fail("Tracking.ReferenceLandmarkRatio", "a share from 0 (off) to 1");

@@ -58,6 +58,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.surface_step_px) p.lidar.surface_step_px = *s.surface_step_px;
   if (s.registration_sigma_deg) p.system.depth_noise.registration_sigma_deg = *s.registration_sigma_deg;
   if (s.scan_time_offset) p.system.scan_time_offset = *s.scan_time_offset;
+  if (s.elevation_correction_deg) p.system.tracker.scan_sample.elevation_correction_deg = *s.elevation_correction_deg;
   if (s.T_cam_lidar) {
     p.calibration.T_cam_lidar = *s.T_cam_lidar;
     p.notes.push_back(fmt::format("{}: LiDAR.Tr overrides the dataset's LiDAR extrinsics", s.file.string()));
@@ -89,6 +90,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (l.bridge_max_gap_s) loop.bridge.max_gap_s = *l.bridge_max_gap_s;
   if (s.place_culling) p.system.mapping.place_culling = *s.place_culling;
   if (s.lidar_pair_sigma) p.system.mapping.pairs.lidar_sigma_translation = *s.lidar_pair_sigma;
+  if (s.lidar_pair_sigma_rotation) p.system.mapping.pairs.lidar_sigma_rotation = *s.lidar_pair_sigma_rotation;
   if (s.reference_landmark_ratio) p.system.tracker.reference_landmark_ratio = *s.reference_landmark_ratio;
   if (s.bounded_depth_error) p.system.tracker.pose.bounded_depth_error = *s.bounded_depth_error;
   if (s.register_gaps) p.system.tracker.register_gaps = *s.register_gaps;

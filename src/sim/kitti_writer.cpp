@@ -94,6 +94,10 @@ class SequenceWriter {
                        o.frames, to_string(o.path.kind), o.speed, o.frame_period, o.width, o.height);
     out << fmt::format("image_noise_sigma: {}\ndepth_camera: {}\nlidar_range_noise_sigma: {}\nlidar_dropout: {}\n",
                        o.image_noise_sigma, o.depth_camera, o.lidar.range_noise_sigma, o.lidar.dropout);
+    if (o.lidar.elevation_offset_deg != 0.0 || o.lidar.beam_elevation_sigma_deg != 0.0) {
+      out << fmt::format("lidar_elevation_offset_deg: {}\nlidar_beam_elevation_sigma_deg: {}\n", o.lidar.elevation_offset_deg,
+                         o.lidar.beam_elevation_sigma_deg);
+    }
     if (!o.speed_phases.empty()) {
       out << "speed_phases:";
       for (const SpeedPhase& p : o.speed_phases) out << fmt::format(" {}s@{}m/s2", p.duration, p.acceleration);

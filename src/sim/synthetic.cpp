@@ -341,6 +341,10 @@ void SimLidarOptions::validate() const {
   require(dropout >= 0.0 && dropout < 1.0, "lidar.dropout", "a probability in [0, 1)");
   require(foliage_penetration >= 0.0 && foliage_penetration <= 2.0, "lidar.foliage_penetration",
           "a mean depth in [0, 2] m");
+  require(std::isfinite(elevation_offset_deg) && std::abs(elevation_offset_deg) <= 2.0, "lidar.elevation_offset_deg",
+          "an offset in [-2, 2] deg");
+  require(std::isfinite(beam_elevation_sigma_deg) && beam_elevation_sigma_deg >= 0.0 && beam_elevation_sigma_deg <= 2.0,
+          "lidar.beam_elevation_sigma_deg", "a sigma in [0, 2] deg");
   require(T_cam0_lidar.matrix().allFinite(), "lidar.T_cam0_lidar", "a finite rigid transform");
 }
 
@@ -608,15 +612,26 @@ std::vector<LidarPoint> SyntheticGenerator::render_scan(int frame) const {
   const int columns = static_cast<int>(std::lround(360.0 / lo.azimuth_step_deg));
   const std::uint64_t key = sim_detail::mix64(options_.seed, static_cast<std::uint64_t>(frame), 0x11DA5ULL);
   std::vector<std::vector<LidarPoint>> rings(elevations.size());
+  // the beams' true elevations: the nominal ones off by the calibration's error, the same in every frame
+  std::vector<double> fired(elevations.size());
+  for (std::size_t b = 0; b < elevations.size(); ++b) {
+    const double error = lo.beam_elevation_sigma_deg > 0.0
+                             ? lo.beam_elevation_sigma_deg *
+                                   sim_detail::gaussian(sim_detail::mix64(options_.seed, b, 0xBEA4E1ULL))
+                             : 0.0;
+    fired[b] = (elevations[b] + lo.elevation_offset_deg + error) * kDeg;
+  }
   parallel_for(static_cast<int>(elevations.size()), options_.threads, [&](int b) {
     const double e = elevations[static_cast<std::size_t>(b)] * kDeg;
+    const double e_fired = fired[static_cast<std::size_t>(b)];
     auto& ring = rings[static_cast<std::size_t>(b)];
     ring.reserve(static_cast<std::size_t>(columns));
     for (int k = 0; k < columns; ++k) {
       // Rings sweep from straight behind, counter-clockwise seen from above (as KITTI's scans).
       const double azimuth = -std::numbers::pi + (k + 0.5) * 2.0 * std::numbers::pi / columns;
       const Eigen::Vector3d dir(std::cos(e) * std::cos(azimuth), std::cos(e) * std::sin(azimuth), std::sin(e));
-      const Eigen::Vector3d d = R * dir;
+      const Eigen::Vector3d d =
+          R * Eigen::Vector3d(std::cos(e_fired) * std::cos(azimuth), std::cos(e_fired) * std::sin(azimuth), std::sin(e_fired));
       const auto hit = scene.intersect(origin, d, lo.max_range);
       if (!hit || hit->t < lo.min_range) continue;
       const std::uint64_t h = sim_detail::mix64(key, static_cast<std::uint64_t>(b) * 100000U + static_cast<std::uint64_t>(k));

@@ -6,12 +6,15 @@
 #include "rgbl/geometry/scan_registration.hpp"
 #include "rgbl/map/fusion.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <mutex>
 #include <map>
 #include <shared_mutex>
+#include <string>
 #include <utility>
 
 namespace rgbl {
@@ -72,6 +75,7 @@ std::vector<LidarPoint> as_points(const ScanSample& sample) {
 void LocalMapper::measure_lidar_pair(KeyframeId id) {
   std::shared_ptr<const ScanSample> scan, previous_scan;
   Eigen::Isometry3d T_cam_previous = Eigen::Isometry3d::Identity();
+  std::size_t frame = 0, previous_frame = 0;  // for the log
   {
     // A keyframe's scan is needed until the next keyframe is registered onto it, no longer: the
     // previous one's is handed over here (a KITTI sample: ~14 000 points of 12 bytes; thousands of keyframes on a long
@@ -84,6 +88,8 @@ void LocalMapper::measure_lidar_pair(KeyframeId id) {
     if (!kf->scan || !previous_scan) return;
     scan = kf->scan;
     T_cam_previous = kf->T_cam_previous;
+    frame = kf->frame_index;
+    previous_frame = previous->frame_index;
   }
   // both samples are in their camera frames: the registration is between the cameras
   Stopwatch watch;
@@ -94,19 +100,27 @@ void LocalMapper::measure_lidar_pair(KeyframeId id) {
     logger()->debug("keyframe {}: LiDAR pair not kept (too little to register)", id.value);
     return;
   }
-  if (!r->converged || r->min_probe_loss <= options_.lidar_min_probe_loss) {
-    logger()->debug("keyframe {}: LiDAR pair not kept (converged {}, probe loss {:.4f})", id.value, r->converged,
-                    r->min_probe_loss);
-    return;
-  }
   const Eigen::Isometry3d measured = r->T_reference_query.inverse();
   const Eigen::Isometry3d change = measured * T_cam_previous.inverse();
   const double change_deg = Eigen::AngleAxisd(change.linear()).angle() * 180.0 / std::numbers::pi;
-  logger()->debug("keyframe {}: LiDAR pair {:.3f} m, {:.3f} deg from the tracked step of {:.3f} m (its own {:.3f} m; "
-                  "probe loss {:.4f}; {} and {} points, {:.1f} ms)",
-                  id.value, change.translation().norm(), change_deg, T_cam_previous.translation().norm(),
-                  measured.translation().norm(), r->min_probe_loss, reference.size(), query.size(), ms);
-  if (change.translation().norm() > options_.lidar_max_change_m || change_deg > options_.lidar_max_change_deg) return;
+  const char* refused = !r->converged                                         ? "not converged"
+                        : r->min_probe_loss <= options_.lidar_min_probe_loss ? "not pinned down"
+                        : change.translation().norm() > options_.lidar_max_change_m ||
+                                change_deg > options_.lidar_max_change_deg
+                            ? "too far from the tracked step"
+                            : nullptr;
+  if (logger()->should_log(spdlog::level::debug)) {
+    const Eigen::AngleAxisd turn(measured.linear());
+    const Eigen::Vector3d t = measured.translation(), w = turn.angle() * turn.axis();
+    logger()->debug("keyframe {}: LiDAR pair {} ({:.3f} m, {:.3f} deg from the tracked step of {:.3f} m; its own {:.3f} m; "
+                    "probe loss {:.4f}; {} and {} points, {:.1f} ms; frames {} -> {}, T_cam_previous t {:.5f} {:.5f} "
+                    "{:.5f} rad {:.6f} {:.6f} {:.6f})",
+                    id.value, refused != nullptr ? fmt::format("not kept: {}", refused) : std::string("kept"),
+                    change.translation().norm(), change_deg, T_cam_previous.translation().norm(),
+                    measured.translation().norm(), r->min_probe_loss, reference.size(), query.size(), ms,
+                    previous_frame, frame, t.x(), t.y(), t.z(), w.x(), w.y(), w.z());
+  }
+  if (refused != nullptr) return;
   std::unique_lock lock(map_.mutex());
   // the previous keyframe may have been erased meanwhile (its motion handed on): then this is stale
   if (Keyframe* kf = map_.keyframe(id); kf != nullptr && kf->T_cam_previous.isApprox(T_cam_previous)) {

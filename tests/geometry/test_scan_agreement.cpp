@@ -176,6 +176,31 @@ TEST_CASE("scan vote: McNemar's bound at 3 sigma decides, nothing below it") {
   CHECK(rgbl::ScanVote{150, 100}.preference() == -1);
 }
 
+TEST_CASE("scan sample: an elevation correction turns each return up about p x z, its range and azimuth kept") {
+  // returns in four directions, on and off the horizon; the identity keeps the LiDAR frame
+  const std::vector<rgbl::LidarPoint> scan = {
+      {10.0F, 0.0F, -1.73F, 0.0F}, {0.0F, -20.0F, 0.0F, 0.0F}, {-6.0F, 8.0F, 2.0F, 0.0F}, {3.0F, 4.0F, -12.0F, 0.0F}};
+  rgbl::ScanSampleOptions options;
+  options.stride = 1;
+  options.elevation_correction_deg = 0.205;
+  const rgbl::ScanSample turned = rgbl::sample_scan(scan, Eigen::Isometry3d::Identity(), options);
+  REQUIRE(turned.points.size() == scan.size());
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    const Eigen::Vector3d p(scan[i].x, scan[i].y, scan[i].z), q = turned.points[i].cast<double>();
+    CHECK_THAT(q.norm(), Catch::Matchers::WithinRel(p.norm(), 1e-6));
+    CHECK_THAT(std::atan2(q.y(), q.x()), Catch::Matchers::WithinAbs(std::atan2(p.y(), p.x()), 1e-6));
+    const double elevation = std::asin(p.z() / p.norm()), turned_elevation = std::asin(q.z() / q.norm());
+    CHECK_THAT(turned_elevation - elevation, Catch::Matchers::WithinAbs(0.205 * kDeg, 1e-6));
+  }
+  // the road 10 m ahead of a LiDAR 1.73 m up comes 0.036 m up and 0.006 m nearer
+  const double a = 0.205 * kDeg;
+  CHECK_THAT(turned.points[0].z(), Catch::Matchers::WithinAbs(10.0 * std::sin(a) - 1.73 * std::cos(a), 1e-5));
+  CHECK_THAT(turned.points[0].x(), Catch::Matchers::WithinAbs(10.0 * std::cos(a) + 1.73 * std::sin(a), 1e-5));
+  options.elevation_correction_deg = 2.5;
+  CHECK_THROWS_AS(options.validate(), rgbl::ConfigError);
+}
+
 TEST_CASE("scan sample: every stride-th return within the range band, in the camera frame") {
   std::vector<rgbl::LidarPoint> scan;
   for (int i = 0; i < 100; ++i) scan.push_back({static_cast<float>(i), 0.0F, 0.0F, 0.0F});  // x ahead, 0..99 m

@@ -230,6 +230,32 @@ TEST_CASE("settings: LocalMapping.PlaceCulling switches keyframe culling by revi
              Contains("'LocalMapping.PlaceCulling': expected 0 (off) or 1 (on)"));
 }
 
+TEST_CASE("settings: LocalMapping.LidarPairSigma and LidarPairSigmaRotation, read and validated", "[io][settings]") {
+  rgbl::test::TempDir tmp;
+  const auto s = rgbl::read_settings(
+      tmp.write("t.yaml", "%YAML:1.0\nLocalMapping.LidarPairSigma: 0.01\nLocalMapping.LidarPairSigmaRotation: 0.0007\n"));
+  CHECK(s.lidar_pair_sigma == 0.01);
+  CHECK(s.lidar_pair_sigma_rotation == 0.0007);
+  CHECK(s.warnings.empty());
+  const auto unset = rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n"));
+  CHECK_FALSE(unset.lidar_pair_sigma);
+  CHECK_FALSE(unset.lidar_pair_sigma_rotation);
+  CHECK_THAT(error_of(tmp.write("bad.yaml", "%YAML:1.0\nLocalMapping.LidarPairSigma: 2\n")),
+             Contains("'LocalMapping.LidarPairSigma': expected a sigma from 0 (off) to 1 m"));
+  // 0 would divide the pair's residual by zero: the pair is switched off by LidarPairSigma alone
+  CHECK_THAT(error_of(tmp.write("zero.yaml", "%YAML:1.0\nLocalMapping.LidarPairSigmaRotation: 0\n")),
+             Contains("'LocalMapping.LidarPairSigmaRotation': expected a sigma above 0 and at most 0.1 rad"));
+}
+
+TEST_CASE("settings: LiDAR.ElevationCorrection, read and validated", "[io][settings]") {
+  rgbl::test::TempDir tmp;
+  CHECK(rgbl::read_settings(tmp.write("t.yaml", "%YAML:1.0\nLiDAR.ElevationCorrection: 0.205\n")).elevation_correction_deg ==
+        0.205);
+  CHECK_FALSE(rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n")).elevation_correction_deg);
+  CHECK_THAT(error_of(tmp.write("bad.yaml", "%YAML:1.0\nLiDAR.ElevationCorrection: 5\n")),
+             Contains("'LiDAR.ElevationCorrection': expected an angle in deg, -2 .. 2"));
+}
+
 TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError and RegisterGaps, read and validated", "[io][settings]") {
   rgbl::test::TempDir tmp;
   const auto s = rgbl::read_settings(tmp.write(

@@ -201,6 +201,21 @@ TEST_CASE("the settings file's Tracking keys reach the tracker") {
   CHECK_FALSE(set.register_gaps);
 }
 
+TEST_CASE("the settings file's LiDAR pair sigmas and elevation correction reach local mapping and the scan samples") {
+  rgbl::test::TempDir dir;
+  auto o = options();
+  const rgbl::KeyframePairOptions defaults = rgbl::Pipeline(o).system_options().mapping.pairs;
+  CHECK(defaults.lidar_sigma_translation == 0.02);
+  CHECK(defaults.lidar_sigma_rotation == 0.002);
+  o.settings = dir.write("t.yaml", "%YAML:1.0\nLocalMapping.LidarPairSigma: 0\nLocalMapping.LidarPairSigmaRotation: 0.001\n");
+  const rgbl::KeyframePairOptions set = rgbl::Pipeline(o).system_options().mapping.pairs;
+  CHECK(set.lidar_sigma_translation == 0.0);
+  CHECK(set.lidar_sigma_rotation == 0.001);
+  CHECK(rgbl::Pipeline(o).system_options().tracker.scan_sample.elevation_correction_deg == 0.0);
+  o.settings = dir.write("e.yaml", "%YAML:1.0\nLiDAR.ElevationCorrection: 0.205\n");
+  CHECK(rgbl::Pipeline(o).system_options().tracker.scan_sample.elevation_correction_deg == 0.205);
+}
+
 TEST_CASE("a run that tracks nothing says so in its metrics: no figure for tracked frames") {
   // 100 features leave fewer keypoints with depth than initialisation needs: no frame is tracked
   rgbl::test::TempDir dir;

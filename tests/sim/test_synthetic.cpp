@@ -180,6 +180,82 @@ TEST_CASE("LiDAR: HDL-64E-like beams, range noise and dropout as asked") {
   CHECK_THAT(static_cast<double>(sparse.size()) / n, WithinAbs(0.7, 0.01));
 }
 
+TEST_CASE("LiDAR beams fire off their nominal elevations by the calibration error, the points keep the nominal ones") {
+  rgbl::SyntheticOptions o = small_options();
+  o.lidar.range_noise_sigma = 0.0;
+  const std::vector<double> nominal = o.lidar.elevations_deg();
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  // A point as the beam really fired: its range along the nominal azimuth, at the nominal elevation
+  // plus `error_deg`; on a surface of the scene when error_deg is the beam's true error.
+  const auto fired_point = [](const rgbl::LidarPoint& p, double e_nominal, double error_deg) {
+    const double r = std::sqrt(double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z);
+    const double azimuth = std::atan2(double(p.y), double(p.x)), e = e_nominal + error_deg * kDeg;
+    return Eigen::Vector3d(r * std::cos(e) * std::cos(azimuth), r * std::cos(e) * std::sin(azimuth), r * std::sin(e));
+  };
+  // The beam of a point: its elevation is the nominal one (the points are computed with it).
+  const auto beam_of = [&](const rgbl::LidarPoint& p) {
+    const double r = std::sqrt(double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z);
+    const double e = std::asin(double(p.z) / r) / kDeg;
+    std::size_t best = 0;
+    for (std::size_t b = 1; b < nominal.size(); ++b) {
+      if (std::abs(nominal[b] - e) < std::abs(nominal[best] - e)) best = b;
+    }
+    REQUIRE(std::abs(nominal[best] - e) < 1e-3);  // float storage
+    return best;
+  };
+  // Each beam's error, recovered from the scan alone: the one that puts its points on the scene.
+  const auto recovered_errors = [&](const rgbl::SyntheticGenerator& g, int frame) {
+    const std::vector<rgbl::LidarPoint> scan = g.render_scan(frame);
+    std::vector<std::vector<rgbl::LidarPoint>> beams(nominal.size());
+    for (std::size_t i = 0; i < scan.size(); i += 7) {
+      auto& beam = beams[beam_of(scan[i])];
+      if (beam.size() < 12) beam.push_back(scan[i]);
+    }
+    const Eigen::Isometry3d T_world_lidar = g.pose(frame) * g.calibration().T_cam0_lidar;
+    std::vector<double> errors;
+    for (std::size_t b = 0; b < beams.size(); ++b) {
+      if (beams[b].size() < 12) continue;
+      double best = 0.0, best_cost = 1e30;
+      for (int k = -600; k <= 600; ++k) {  // -0.6 .. 0.6 deg in steps of 0.001
+        double cost = 0.0;
+        for (const auto& p : beams[b]) {
+          cost += std::abs(g.scene().signed_distance(T_world_lidar * fired_point(p, nominal[b] * kDeg, k * 0.001)));
+        }
+        if (cost < best_cost) best_cost = cost, best = k * 0.001;
+      }
+      CHECK(best_cost / 12.0 < 2e-3);  // the beam's points lie on the scene again
+      errors.push_back(best);
+    }
+    return errors;
+  };
+
+  SECTION("exact beams by default") {
+    const rgbl::SyntheticGenerator g(o);
+    const std::vector<double> errors = recovered_errors(g, 1);
+    REQUIRE(errors.size() > 50);
+    for (const double e : errors) CHECK_THAT(e, WithinAbs(0.0, 0.0015));
+  }
+  SECTION("an offset in all beams, and each beam's own error, the same in every frame") {
+    o.lidar.elevation_offset_deg = 0.2;
+    o.lidar.beam_elevation_sigma_deg = 0.1;
+    const rgbl::SyntheticGenerator g(o);
+    const std::vector<double> first = recovered_errors(g, 0), later = recovered_errors(g, 2);
+    REQUIRE(first.size() > 50);
+    REQUIRE(later.size() == first.size());
+    double sum = 0.0, sum2 = 0.0;
+    for (std::size_t b = 0; b < first.size(); ++b) {
+      CHECK_THAT(later[b], WithinAbs(first[b], 0.0015));
+      sum += first[b];
+      sum2 += first[b] * first[b];
+    }
+    const double n = static_cast<double>(first.size()), mean = sum / n;
+    const double sigma = std::sqrt(sum2 / n - mean * mean);
+    CHECK_THAT(mean, WithinAbs(0.2, 0.04));   // 0.1 / sqrt(64) per beam draw: 3 sigmas
+    CHECK(sigma > 0.07);
+    CHECK(sigma < 0.13);
+  }
+}
+
 TEST_CASE("projected noiseless LiDAR agrees with the exact depth image") {
   rgbl::SyntheticOptions o = small_options();
   o.width = 613;  // the default size: projection is pixel-exact only up to half a pixel
@@ -315,6 +391,12 @@ TEST_CASE("options validate and name the key") {
   bad = o;
   bad.lidar.dropout = 1.0;
   CHECK(key_of(bad) == "lidar.dropout");
+  bad = o;
+  bad.lidar.beam_elevation_sigma_deg = -0.1;
+  CHECK(key_of(bad) == "lidar.beam_elevation_sigma_deg");
+  bad = o;
+  bad.lidar.elevation_offset_deg = 3.0;
+  CHECK(key_of(bad) == "lidar.elevation_offset_deg");
   bad = o;
   bad.untextured = rgbl::FrameRange{5, 60};
   CHECK(key_of(bad) == "untextured");

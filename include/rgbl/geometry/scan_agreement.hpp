@@ -24,6 +24,11 @@ struct ScanSampleOptions {
   double min_range = 2.0;    // m: nearer returns are the car itself
   double max_range = 40.0;   // m: farther ones are too sparse to land on each other
   double tolerance = 0.3;    // m: a return agrees when a return of the other scan lies this close
+  // Turns every return up by this angle about p x z in the LiDAR frame, its range kept: the correction
+  // of a LiDAR whose beams fire higher than its points say (KITTI's HDL-64: 0.205 deg, as CT-ICP and
+  // kiss-icp apply it). The sample only (scan agreement, road planes, the keyframes' scan pairs), not
+  // the depth. 0 = the points as recorded.
+  double elevation_correction_deg = 0.0;
 
   void validate() const;
 };

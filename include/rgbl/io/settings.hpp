@@ -16,6 +16,8 @@
 //   LiDAR.RegistrationSigmaDeg (DepthNoiseModel::registration_sigma_deg, 0 = off, default 0.1),
 //   LiDAR.TimeOffset (SystemOptions::scan_time_offset: the image's time minus the scan's, seconds;
 //   overrides the dataset's scan timestamps, 0 = simultaneous),
+//   LiDAR.ElevationCorrection (ScanSampleOptions::elevation_correction_deg, -2 .. 2 deg, default 0: every
+//   return of the scan samples turned up by it, e.g. KITTI's HDL-64 0.205; not the depth),
 //   rgbl's own Tracking.ReferenceLandmarkRatio (TrackerOptions::reference_landmark_ratio, 0..1) and
 //   Tracking.BoundedDepthError (0/1, PoseOptimizerOptions::bounded_depth_error of the tracker),
 //   Tracking.RegisterGaps (0/1, TrackerOptions::register_gaps: the scans registered across a gap),
@@ -23,7 +25,8 @@
 //   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
 //   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1), MergeMaps (0/1) (LoopClosingOptions' fields of those
 //   names), LocalMapping.PlaceCulling (0/1), LocalMapping.LidarPairSigma (m, 0 = off, default 0.02:
-//   KeyframePairOptions::lidar_sigma_translation, keyframes tied by their scans' registration).
+//   KeyframePairOptions::lidar_sigma_translation, keyframes tied by their scans' registration),
+//   LocalMapping.LidarPairSigmaRotation (rad: that pair's lidar_sigma_rotation).
 // Viewer.* and other display-only ORB-SLAM keys are accepted and ignored without a warning.
 
 #include "rgbl/geometry/camera.hpp"
@@ -90,11 +93,15 @@ struct Settings {
   std::optional<double> surface_fit_window_deg;  // LiDAR.SurfaceFitWindowDeg; unset = the source's default (0.5)
   std::optional<int> surface_step_px;            // LiDAR.SurfaceStepPx; unset = the source's default (2)
   std::optional<double> registration_sigma_deg;  // LiDAR.RegistrationSigmaDeg; unset = the model's default
+  // LiDAR.ElevationCorrection: ScanSampleOptions::elevation_correction_deg (deg; the scan samples only)
+  std::optional<double> elevation_correction_deg;
   std::optional<double> scan_time_offset;      // LiDAR.TimeOffset, s; unset = the dataset's scan timestamps
   LoopClosingSettings loop_closing;
   std::optional<bool> place_culling;  // LocalMapping.PlaceCulling: keyframe culling by revisits
   // LocalMapping.LidarPairSigma: KeyframePairOptions::lidar_sigma_translation (m, 0 = off)
   std::optional<double> lidar_pair_sigma;
+  // LocalMapping.LidarPairSigmaRotation: KeyframePairOptions::lidar_sigma_rotation (rad, > 0)
+  std::optional<double> lidar_pair_sigma_rotation;
   std::optional<double> reference_landmark_ratio;  // Tracking.ReferenceLandmarkRatio
   std::optional<bool> bounded_depth_error;          // Tracking.BoundedDepthError
   std::optional<bool> register_gaps;                // Tracking.RegisterGaps

@@ -46,6 +46,13 @@ struct SimLidarOptions {
   // Leaf penetration: returns from foliage land this much deeper on average (one-sided, half-normal
   // with this mean), on top of range_noise_sigma; 0 = foliage is as solid as a wall.
   double foliage_penetration = 0.0;  // m
+  // The intrinsic calibration's error: each beam fires at its nominal elevation plus an error (all
+  // beams' elevation_offset_deg, and a Gaussian of beam_elevation_sigma_deg drawn once per beam and
+  // seed), while its points are computed with the nominal one, as a real LiDAR's are. KITTI's HDL-64
+  // is known for one of about 0.2 deg in all beams (docs/accuracy.md, "What lengthens 04's path").
+  // 0 = exact beams.
+  double elevation_offset_deg = 0.0;
+  double beam_elevation_sigma_deg = 0.0;
   Eigen::Isometry3d T_cam0_lidar = kitti_odometry_04_calibration().T_cam0_lidar;  // KITTI 04's Tr
 
   void validate() const;
