@@ -18,7 +18,7 @@ import re
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-LINE = re.compile(r'LiDAR pair (kept|not kept: [a-z ]+) \(.*?probe loss (\S+);.*?frames (\d+) -> (\d+), '
+LINE = re.compile(r'LiDAR pair (kept|not kept: [a-z ]+) \(.*?probe loss (\S+?)[,;].*?frames (\d+) -> (\d+), '
                   r'T_cam_previous t (\S+) (\S+) (\S+) rad (\S+) (\S+) ([-0-9.e]+)\)')
 
 

@@ -113,11 +113,11 @@ void LocalMapper::measure_lidar_pair(KeyframeId id) {
     const Eigen::AngleAxisd turn(measured.linear());
     const Eigen::Vector3d t = measured.translation(), w = turn.angle() * turn.axis();
     logger()->debug("keyframe {}: LiDAR pair {} ({:.3f} m, {:.3f} deg from the tracked step of {:.3f} m; its own {:.3f} m; "
-                    "probe loss {:.4f}; {} and {} points, {:.1f} ms; frames {} -> {}, T_cam_previous t {:.5f} {:.5f} "
+                    "probe loss {:.4f}, landing {:.3f}; {} and {} points, {:.1f} ms; frames {} -> {}, T_cam_previous t {:.5f} {:.5f} "
                     "{:.5f} rad {:.6f} {:.6f} {:.6f})",
                     id.value, refused != nullptr ? fmt::format("not kept: {}", refused) : std::string("kept"),
                     change.translation().norm(), change_deg, T_cam_previous.translation().norm(),
-                    measured.translation().norm(), r->min_probe_loss, reference.size(), query.size(), ms,
+                    measured.translation().norm(), r->min_probe_loss, r->agreement, reference.size(), query.size(), ms,
                     previous_frame, frame, t.x(), t.y(), t.z(), w.x(), w.y(), w.z());
   }
   if (refused != nullptr) return;

@@ -5,6 +5,7 @@
 #include "support/temp_dir.hpp"
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 using Catch::Matchers::Contains;
 
@@ -230,30 +231,35 @@ TEST_CASE("settings: LocalMapping.PlaceCulling switches keyframe culling by revi
              Contains("'LocalMapping.PlaceCulling': expected 0 (off) or 1 (on)"));
 }
 
-TEST_CASE("settings: LocalMapping.LidarPairSigma and LidarPairSigmaRotation, read and validated", "[io][settings]") {
+TEST_CASE("settings: the LiDAR pair's sigmas and the scan samples' elevation correction, read and validated",
+          "[io][settings]") {
+  // key, a value it takes, where it lands, a value it refuses and what the error says is expected
+  struct Key {
+    const char* name;
+    double value;
+    std::optional<double> rgbl::Settings::*field;
+    const char* refused;
+    const char* expected;
+  };
+  const Key keys[] = {
+      {"LocalMapping.LidarPairSigma", 0.01, &rgbl::Settings::lidar_pair_sigma, "2", "a sigma from 0 (off) to 1 m"},
+      // 0 would divide the pair's residual by zero: the pair is switched off by LidarPairSigma alone
+      {"LocalMapping.LidarPairSigmaRotation", 0.0007, &rgbl::Settings::lidar_pair_sigma_rotation, "0",
+       "a sigma above 0 and at most 0.1 rad"},
+      {"LiDAR.ElevationCorrection", 0.205, &rgbl::Settings::elevation_correction_deg, "5",
+       "an angle in deg, -2 .. 2"},
+  };
   rgbl::test::TempDir tmp;
-  const auto s = rgbl::read_settings(
-      tmp.write("t.yaml", "%YAML:1.0\nLocalMapping.LidarPairSigma: 0.01\nLocalMapping.LidarPairSigmaRotation: 0.0007\n"));
-  CHECK(s.lidar_pair_sigma == 0.01);
-  CHECK(s.lidar_pair_sigma_rotation == 0.0007);
-  CHECK(s.warnings.empty());
   const auto unset = rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n"));
-  CHECK_FALSE(unset.lidar_pair_sigma);
-  CHECK_FALSE(unset.lidar_pair_sigma_rotation);
-  CHECK_THAT(error_of(tmp.write("bad.yaml", "%YAML:1.0\nLocalMapping.LidarPairSigma: 2\n")),
-             Contains("'LocalMapping.LidarPairSigma': expected a sigma from 0 (off) to 1 m"));
-  // 0 would divide the pair's residual by zero: the pair is switched off by LidarPairSigma alone
-  CHECK_THAT(error_of(tmp.write("zero.yaml", "%YAML:1.0\nLocalMapping.LidarPairSigmaRotation: 0\n")),
-             Contains("'LocalMapping.LidarPairSigmaRotation': expected a sigma above 0 and at most 0.1 rad"));
-}
-
-TEST_CASE("settings: LiDAR.ElevationCorrection, read and validated", "[io][settings]") {
-  rgbl::test::TempDir tmp;
-  CHECK(rgbl::read_settings(tmp.write("t.yaml", "%YAML:1.0\nLiDAR.ElevationCorrection: 0.205\n")).elevation_correction_deg ==
-        0.205);
-  CHECK_FALSE(rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n")).elevation_correction_deg);
-  CHECK_THAT(error_of(tmp.write("bad.yaml", "%YAML:1.0\nLiDAR.ElevationCorrection: 5\n")),
-             Contains("'LiDAR.ElevationCorrection': expected an angle in deg, -2 .. 2"));
+  for (const Key& key : keys) {
+    INFO(key.name);
+    const auto s = rgbl::read_settings(tmp.write("t.yaml", fmt::format("%YAML:1.0\n{}: {}\n", key.name, key.value)));
+    CHECK(s.*key.field == key.value);
+    CHECK(s.warnings.empty());
+    CHECK_FALSE(unset.*key.field);
+    CHECK_THAT(error_of(tmp.write("bad.yaml", fmt::format("%YAML:1.0\n{}: {}\n", key.name, key.refused))),
+               Contains(fmt::format("'{}': expected {}", key.name, key.expected)));
+  }
 }
 
 TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError and RegisterGaps, read and validated", "[io][settings]") {

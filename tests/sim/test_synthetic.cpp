@@ -215,13 +215,21 @@ TEST_CASE("LiDAR beams fire off their nominal elevations by the calibration erro
     std::vector<double> errors;
     for (std::size_t b = 0; b < beams.size(); ++b) {
       if (beams[b].size() < 12) continue;
-      double best = 0.0, best_cost = 1e30;
-      for (int k = -600; k <= 600; ++k) {  // -0.6 .. 0.6 deg in steps of 0.001
+      const auto cost_of = [&](double error_deg) {
         double cost = 0.0;
         for (const auto& p : beams[b]) {
-          cost += std::abs(g.scene().signed_distance(T_world_lidar * fired_point(p, nominal[b] * kDeg, k * 0.001)));
+          cost += std::abs(g.scene().signed_distance(T_world_lidar * fired_point(p, nominal[b] * kDeg, error_deg)));
         }
-        if (cost < best_cost) best_cost = cost, best = k * 0.001;
+        return cost;
+      };
+      // -0.6 .. 0.6 deg in steps of 0.01, then 0.001 around the best
+      double best = 0.0, best_cost = 1e30;
+      for (int k = -60; k <= 60; ++k) {
+        if (const double cost = cost_of(k * 0.01); cost < best_cost) best_cost = cost, best = k * 0.01;
+      }
+      const double coarse = best;
+      for (int k = -10; k <= 10; ++k) {
+        if (const double cost = cost_of(coarse + k * 0.001); cost < best_cost) best_cost = cost, best = coarse + k * 0.001;
       }
       CHECK(best_cost / 12.0 < 2e-3);  // the beam's points lie on the scene again
       errors.push_back(best);
