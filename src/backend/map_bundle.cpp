@@ -1,6 +1,7 @@
 #include "rgbl/backend/map_bundle.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/geometry/se3.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -73,6 +74,8 @@ void KeyframePairOptions::validate() const {
           "keyframe_pairs.lidar_sigma_translation", ">= 0 m (0 = off)");
   require(std::isfinite(lidar_sigma_rotation) && lidar_sigma_rotation > 0.0, "keyframe_pairs.lidar_sigma_rotation",
           "> 0 rad");
+  require(std::isfinite(lidar_agreeing_sigma_translation) && lidar_agreeing_sigma_translation >= 0.0,
+          "keyframe_pairs.lidar_agreeing_sigma_translation", ">= 0 m (0 = lidar_sigma_translation)");
 }
 
 void add_keyframe_pairs(const Map& map, MapBundle& bundle, const KeyframePairOptions& options) {
@@ -121,8 +124,13 @@ void add_keyframe_pairs(const Map& map, MapBundle& bundle, const KeyframePairOpt
   if (options.lidar_sigma_translation > 0.0) {
     for_each_with_previous([&](const Keyframe& kf, int a, int b) {
       if (!kf.T_cam_previous_lidar) return;
+      const Eigen::Isometry3d change = *kf.T_cam_previous_lidar * kf.T_cam_previous.inverse();
+      const bool agreeing = options.lidar_agreeing_sigma_translation > 0.0 &&
+                            change.translation().norm() <= options.odometry_sigma_translation &&
+                            rotation_angle(change.linear()) <= options.odometry_sigma_rotation;
       bundle.problem.pose_pairs.push_back({.pose_a = a, .pose_b = b, .T_b_a = *kf.T_cam_previous_lidar,
-                                           .sigma_translation = options.lidar_sigma_translation,
+                                           .sigma_translation = agreeing ? options.lidar_agreeing_sigma_translation
+                                                                         : options.lidar_sigma_translation,
                                            .sigma_rotation = options.lidar_sigma_rotation});
     });
   }

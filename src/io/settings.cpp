@@ -408,6 +408,9 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.lidar_pair_sigma = r.number({"LocalMapping.LidarPairSigma"});
   if (s.lidar_pair_sigma && !(*s.lidar_pair_sigma >= 0.0 && *s.lidar_pair_sigma <= 1.0))
     r.fail("LocalMapping.LidarPairSigma", "a sigma from 0 (off) to 1 m");
+  s.lidar_pair_agreeing_sigma = r.number({"LocalMapping.LidarPairAgreeingSigma"});
+  if (s.lidar_pair_agreeing_sigma && !(*s.lidar_pair_agreeing_sigma >= 0.0 && *s.lidar_pair_agreeing_sigma <= 1.0))
+    r.fail("LocalMapping.LidarPairAgreeingSigma", "a sigma from 0 (as LidarPairSigma) to 1 m");
   s.lidar_pair_sigma_rotation = r.number({"LocalMapping.LidarPairSigmaRotation"});
   if (s.lidar_pair_sigma_rotation && !(*s.lidar_pair_sigma_rotation > 0.0 && *s.lidar_pair_sigma_rotation <= 0.1))
     r.fail("LocalMapping.LidarPairSigmaRotation", "a sigma above 0 and at most 0.1 rad");

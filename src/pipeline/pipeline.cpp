@@ -91,6 +91,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.place_culling) p.system.mapping.place_culling = *s.place_culling;
   if (s.lidar_pair_sigma) p.system.mapping.pairs.lidar_sigma_translation = *s.lidar_pair_sigma;
   if (s.lidar_pair_sigma_rotation) p.system.mapping.pairs.lidar_sigma_rotation = *s.lidar_pair_sigma_rotation;
+  if (s.lidar_pair_agreeing_sigma) p.system.mapping.pairs.lidar_agreeing_sigma_translation = *s.lidar_pair_agreeing_sigma;
   if (s.reference_landmark_ratio) p.system.tracker.reference_landmark_ratio = *s.reference_landmark_ratio;
   if (s.bounded_depth_error) p.system.tracker.pose.bounded_depth_error = *s.bounded_depth_error;
   if (s.register_gaps) p.system.tracker.register_gaps = *s.register_gaps;

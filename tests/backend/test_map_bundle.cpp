@@ -175,6 +175,24 @@ TEST_CASE("map bundle: keyframe pairs join each optimised keyframe to the road b
   CHECK(lidar.T_b_a.isApprox(lidar_motion));
   CHECK(lidar.sigma_translation == 0.02);
   CHECK(lidar.sigma_rotation == options.lidar_sigma_rotation);
+  // agreeing with the tracked motion within one sigma of its own pair (0.1 m, 0.005 rad): the tighter
+  // sigma; 0.98 m off, or turned 0.01 rad from it: the usual one
+  REQUIRE(options.lidar_agreeing_sigma_translation == 0.01);  // the default
+  const Eigen::Isometry3d tracked = map.keyframe(keyframes[1])->T_cam_previous;
+  const auto sigma_with = [&](const Eigen::Isometry3d& measured) {
+    map.keyframe(keyframes[1])->T_cam_previous_lidar = measured;
+    bundle = rgbl::make_map_bundle(map, window, anchors);
+    rgbl::add_keyframe_pairs(map, bundle, options);
+    REQUIRE(bundle.problem.pose_pairs.size() == 4);
+    return bundle.problem.pose_pairs.back().sigma_translation;
+  };
+  CHECK(sigma_with(lidar_motion) == 0.02);
+  CHECK(sigma_with(Eigen::Translation3d(0.03, 0.0, -0.09) * tracked) == 0.01);
+  CHECK(sigma_with(Eigen::Translation3d(0.03, 0.0, -0.11) * tracked) == 0.02);
+  CHECK(sigma_with(Eigen::Isometry3d(Eigen::AngleAxisd(0.004, Eigen::Vector3d::UnitY())) * tracked) == 0.01);
+  CHECK(sigma_with(Eigen::Isometry3d(Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitY())) * tracked) == 0.02);
+  options.lidar_agreeing_sigma_translation = 0.0;
+  CHECK(sigma_with(Eigen::Translation3d(0.03, 0.0, 0.0) * tracked) == 0.02);
   map.keyframe(keyframes[1])->T_cam_previous_lidar.reset();
   options.lidar_sigma_translation = 0.0;
 
@@ -210,6 +228,9 @@ TEST_CASE("keyframe pair options are checked, naming the field, and 0 turns a pa
   o = {};
   o.lidar_sigma_rotation = 0.0;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("keyframe_pairs.lidar_sigma_rotation"));
+  o = {};
+  o.lidar_agreeing_sigma_translation = -0.01;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("keyframe_pairs.lidar_agreeing_sigma_translation"));
   o = {};
   o.road_sigma_offset = 0.0;
   o.odometry_sigma_translation = 0.0;

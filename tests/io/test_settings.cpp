@@ -246,6 +246,8 @@ TEST_CASE("settings: the LiDAR pair's sigmas and the scan samples' elevation cor
       // 0 would divide the pair's residual by zero: the pair is switched off by LidarPairSigma alone
       {"LocalMapping.LidarPairSigmaRotation", 0.0007, &rgbl::Settings::lidar_pair_sigma_rotation, "0",
        "a sigma above 0 and at most 0.1 rad"},
+      {"LocalMapping.LidarPairAgreeingSigma", 0.01, &rgbl::Settings::lidar_pair_agreeing_sigma, "1.5",
+       "a sigma from 0 (as LidarPairSigma) to 1 m"},
       {"LiDAR.ElevationCorrection", 0.205, &rgbl::Settings::elevation_correction_deg, "5",
        "an angle in deg, -2 .. 2"},
   };

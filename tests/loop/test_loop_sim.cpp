@@ -201,7 +201,9 @@ TEST_CASE("loop closer: a bag of words alone closes the two laps (a depth source
   const Lap& lap = two_laps();
   rgbl::LoopClosingOptions options;
   options.places.methods = {"bow"};
-  const Run with = track(lap, options);
+  // without the scans' keyframe pairs too, as such a source has none (with them these laps hardly
+  // drift, and the bag of words found no closure: 0.034 m)
+  const Run with = track(lap, options, {}, true, true, kDrifting);
   const int closures = check_closures(lap, with, 90);
   fmt::print("two laps of a 100 m loop, bag of words only: {} closures, ATE {:.3f} m, {} candidates verified for {} "
              "keyframes\n",

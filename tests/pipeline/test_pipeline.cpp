@@ -207,10 +207,13 @@ TEST_CASE("the settings file's LiDAR pair sigmas and elevation correction reach 
   const rgbl::KeyframePairOptions defaults = rgbl::Pipeline(o).system_options().mapping.pairs;
   CHECK(defaults.lidar_sigma_translation == 0.02);
   CHECK(defaults.lidar_sigma_rotation == 0.002);
-  o.settings = dir.write("t.yaml", "%YAML:1.0\nLocalMapping.LidarPairSigma: 0\nLocalMapping.LidarPairSigmaRotation: 0.001\n");
+  CHECK(defaults.lidar_agreeing_sigma_translation == 0.01);
+  o.settings = dir.write("t.yaml", "%YAML:1.0\nLocalMapping.LidarPairSigma: 0\nLocalMapping.LidarPairSigmaRotation: "
+                                   "0.001\nLocalMapping.LidarPairAgreeingSigma: 0.005\n");
   const rgbl::KeyframePairOptions set = rgbl::Pipeline(o).system_options().mapping.pairs;
   CHECK(set.lidar_sigma_translation == 0.0);
   CHECK(set.lidar_sigma_rotation == 0.001);
+  CHECK(set.lidar_agreeing_sigma_translation == 0.005);
   CHECK(rgbl::Pipeline(o).system_options().tracker.scan_sample.elevation_correction_deg == 0.0);
   o.settings = dir.write("e.yaml", "%YAML:1.0\nLiDAR.ElevationCorrection: 0.205\n");
   CHECK(rgbl::Pipeline(o).system_options().tracker.scan_sample.elevation_correction_deg == 0.205);
@@ -442,12 +445,15 @@ TEST_CASE("KITTI raw 0009, 51 frames: the scans moved to the images' time (16.9 
   CHECK(simultaneous.scan_age == 0.0);
   INFO("ATE " << moved.ate << " m against " << simultaneous.ate << " m, path / truth " << moved.path_ratio
               << " against " << simultaneous.path_ratio);
-  // docs/accuracy.md, five feature-count samples: 0.081-0.100 m and 1.0024-1.0038 against
-  // 0.096-0.118 m and 1.0045-1.0059
+  // five feature-count samples (nFeatures 1800-2200, 2026-12-05 session 9): 0.085-0.093 m and
+  // 1.0020-1.0031 against 0.096-0.106 m and 1.0032-1.0044, each sample 0.005-0.021 m and 0.0005-0.0025
+  // better. The scans' pairs in local BA measure the keyframes' steps whatever the scans' time, so the
+  // gain is smaller than before them (0.010-0.031 m; docs/accuracy.md, "The LiDAR's depth moved to
+  // the image's time" had 0.081-0.100 against 0.096-0.118 m)
   CHECK(moved.ate < 0.095);
   CHECK(moved.path_ratio < 1.0045);
-  CHECK(moved.ate < simultaneous.ate - 0.015);
-  CHECK(moved.path_ratio < simultaneous.path_ratio - 0.001);
+  CHECK(moved.ate < simultaneous.ate - 0.004);
+  CHECK(moved.path_ratio < simultaneous.path_ratio - 0.0003);
 }
 
 TEST_CASE("the simulator as an in-memory sequence: loaded frames equal the rendered ones, the pipeline tracks it") {

@@ -94,6 +94,9 @@ TEST_CASE("threaded loop closing: the two laps are closed in the loop thread and
   const rgbl::SyntheticGenerator generator(sim);
   rgbl::SystemOptions options;
   options.threaded_mapping = true;
+  // without the scans' keyframe pairs, as test_loop_sim's closure tests: with them the second lap
+  // hardly drifts and the loop thread found no closure (47 keyframes)
+  options.mapping.pairs.lidar_sigma_translation = 0.0;
   const rgbl::test::Mapped m = rgbl::test::track_frames(
       generator.calibration().camera(0), static_cast<std::size_t>(sim.frames),
       [&](std::size_t i) { return rgbl::test::render_frame(generator, static_cast<int>(i)); },

@@ -26,7 +26,8 @@
 //   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1), MergeMaps (0/1) (LoopClosingOptions' fields of those
 //   names), LocalMapping.PlaceCulling (0/1), LocalMapping.LidarPairSigma (m, 0 = off, default 0.02:
 //   KeyframePairOptions::lidar_sigma_translation, keyframes tied by their scans' registration),
-//   LocalMapping.LidarPairSigmaRotation (rad: that pair's lidar_sigma_rotation).
+//   LocalMapping.LidarPairSigmaRotation (rad: that pair's lidar_sigma_rotation),
+//   LocalMapping.LidarPairAgreeingSigma (m, 0 = as LidarPairSigma: lidar_agreeing_sigma_translation).
 // Viewer.* and other display-only ORB-SLAM keys are accepted and ignored without a warning.
 
 #include "rgbl/geometry/camera.hpp"
@@ -102,6 +103,8 @@ struct Settings {
   std::optional<double> lidar_pair_sigma;
   // LocalMapping.LidarPairSigmaRotation: KeyframePairOptions::lidar_sigma_rotation (rad, > 0)
   std::optional<double> lidar_pair_sigma_rotation;
+  // LocalMapping.LidarPairAgreeingSigma: KeyframePairOptions::lidar_agreeing_sigma_translation (m)
+  std::optional<double> lidar_pair_agreeing_sigma;
   std::optional<double> reference_landmark_ratio;  // Tracking.ReferenceLandmarkRatio
   std::optional<bool> bounded_depth_error;          // Tracking.BoundedDepthError
   std::optional<bool> register_gaps;                // Tracking.RegisterGaps
