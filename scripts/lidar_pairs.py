@@ -10,23 +10,18 @@ with the two frames and the registered motion T_cam_previous; RUN is the run's f
 kept, prints how far the registered step is off the truth's (translation, median and largest; rotation
 per camera axis, RMS: pitch about x, yaw about y, roll about z) and, for comparison, how far the
 written trajectory's step between the same frames is off. Then the N pairs furthest off (default 5) with
-their probe loss. Needs python3-numpy and python3-scipy.
+their probe loss. Needs the Python module (PYTHONPATH=build/release/python), python3-numpy and
+python3-scipy.
 """
 import argparse
 import re
 
 import numpy as np
+import rgbl
 from scipy.spatial.transform import Rotation
 
 LINE = re.compile(r'LiDAR pair (kept|not kept: [a-z ]+) \(.*?probe loss (\S+?)[,;].*?frames (\d+) -> (\d+), '
                   r'T_cam_previous t (\S+) (\S+) (\S+) rad (\S+) (\S+) ([-0-9.e]+)\)')
-
-
-def load(path):
-    rows = np.loadtxt(path, ndmin=2)
-    poses = np.tile(np.eye(4), (len(rows), 1, 1))
-    poses[:, :3, :] = rows[:, -12:].reshape(-1, 3, 4)
-    return poses
 
 
 def error(truth_b_a, measured_b_a):
@@ -41,8 +36,8 @@ def main():
     parser.add_argument('run')
     parser.add_argument('--worst', type=int, default=5)
     args = parser.parse_args()
-    truth = load(f'{args.run}/ground_truth_kitti.txt')
-    written = load(f'{args.run}/trajectory_kitti.txt')
+    truth = rgbl.read_kitti_trajectory(f'{args.run}/ground_truth_kitti.txt')
+    written = rgbl.read_kitti_trajectory(f'{args.run}/trajectory_kitti.txt')
     pairs = []
     with open(args.log, encoding='utf-8', errors='replace') as log:
         for line in log:

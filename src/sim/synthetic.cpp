@@ -612,6 +612,10 @@ std::vector<LidarPoint> SyntheticGenerator::render_scan(int frame) const {
   const int columns = static_cast<int>(std::lround(360.0 / lo.azimuth_step_deg));
   const std::uint64_t key = sim_detail::mix64(options_.seed, static_cast<std::uint64_t>(frame), 0x11DA5ULL);
   std::vector<std::vector<LidarPoint>> rings(elevations.size());
+  const auto beam_direction = [](double elevation, double azimuth) {
+    return Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                           std::sin(elevation));
+  };
   // the beams' true elevations: the nominal ones off by the calibration's error, the same in every frame
   std::vector<double> fired(elevations.size());
   for (std::size_t b = 0; b < elevations.size(); ++b) {
@@ -629,9 +633,8 @@ std::vector<LidarPoint> SyntheticGenerator::render_scan(int frame) const {
     for (int k = 0; k < columns; ++k) {
       // Rings sweep from straight behind, counter-clockwise seen from above (as KITTI's scans).
       const double azimuth = -std::numbers::pi + (k + 0.5) * 2.0 * std::numbers::pi / columns;
-      const Eigen::Vector3d dir(std::cos(e) * std::cos(azimuth), std::cos(e) * std::sin(azimuth), std::sin(e));
-      const Eigen::Vector3d d =
-          R * Eigen::Vector3d(std::cos(e_fired) * std::cos(azimuth), std::cos(e_fired) * std::sin(azimuth), std::sin(e_fired));
+      // the point is computed along the nominal direction, the beam travels along the fired one
+      const Eigen::Vector3d dir = beam_direction(e, azimuth), d = R * beam_direction(e_fired, azimuth);
       const auto hit = scene.intersect(origin, d, lo.max_range);
       if (!hit || hit->t < lo.min_range) continue;
       const std::uint64_t h = sim_detail::mix64(key, static_cast<std::uint64_t>(b) * 100000U + static_cast<std::uint64_t>(k));

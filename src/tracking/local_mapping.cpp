@@ -4,9 +4,8 @@
 #include "rgbl/core/log.hpp"
 #include "rgbl/core/timer.hpp"
 #include "rgbl/geometry/scan_registration.hpp"
+#include "rgbl/geometry/se3.hpp"
 #include "rgbl/map/fusion.hpp"
-
-#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +13,6 @@
 #include <mutex>
 #include <map>
 #include <shared_mutex>
-#include <string>
 #include <utility>
 
 namespace rgbl {
@@ -102,7 +100,7 @@ void LocalMapper::measure_lidar_pair(KeyframeId id) {
   }
   const Eigen::Isometry3d measured = r->T_reference_query.inverse();
   const Eigen::Isometry3d change = measured * T_cam_previous.inverse();
-  const double change_deg = Eigen::AngleAxisd(change.linear()).angle() * 180.0 / std::numbers::pi;
+  const double change_deg = rotation_angle(change.linear()) * 180.0 / std::numbers::pi;
   const char* refused = !r->converged                                         ? "not converged"
                         : r->min_probe_loss <= options_.lidar_min_probe_loss ? "not pinned down"
                         : change.translation().norm() > options_.lidar_max_change_m ||
@@ -110,12 +108,12 @@ void LocalMapper::measure_lidar_pair(KeyframeId id) {
                             ? "too far from the tracked step"
                             : nullptr;
   if (logger()->should_log(spdlog::level::debug)) {
-    const Eigen::AngleAxisd turn(measured.linear());
-    const Eigen::Vector3d t = measured.translation(), w = turn.angle() * turn.axis();
-    logger()->debug("keyframe {}: LiDAR pair {} ({:.3f} m, {:.3f} deg from the tracked step of {:.3f} m; its own {:.3f} m; "
+    // the registered motion in full, for scripts/lidar_pairs.py to compare with a ground truth
+    const Eigen::Vector3d t = measured.translation(), w = so3_log(measured.linear());
+    logger()->debug("keyframe {}: LiDAR pair {}{} ({:.3f} m, {:.3f} deg from the tracked step of {:.3f} m; its own {:.3f} m; "
                     "probe loss {:.4f}, landing {:.3f}; {} and {} points, {:.1f} ms; frames {} -> {}, T_cam_previous t {:.5f} {:.5f} "
                     "{:.5f} rad {:.6f} {:.6f} {:.6f})",
-                    id.value, refused != nullptr ? fmt::format("not kept: {}", refused) : std::string("kept"),
+                    id.value, refused != nullptr ? "not kept: " : "kept", refused != nullptr ? refused : "",
                     change.translation().norm(), change_deg, T_cam_previous.translation().norm(),
                     measured.translation().norm(), r->min_probe_loss, r->agreement, reference.size(), query.size(), ms,
                     previous_frame, frame, t.x(), t.y(), t.z(), w.x(), w.y(), w.z());

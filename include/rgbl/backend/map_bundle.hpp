@@ -57,8 +57,9 @@ struct KeyframePairOptions {
   // 0 = off.
   double lidar_sigma_translation = 0.02;  // m
   double lidar_sigma_rotation = 0.002;    // rad
-  // A pair within one sigma of the tracked motion's own pair (odometry_sigma_*) of the tracked motion
-  // takes this translation sigma instead (0 = lidar_sigma_translation): two sensors that agree are
+  // A pair that lies within one sigma of the tracked motion's own pair (odometry_sigma_translation and
+  // odometry_sigma_rotation) from the tracked motion takes this translation sigma instead (0 =
+  // lidar_sigma_translation; none agrees while the odometry pair is off): two sensors that agree are
   // trusted more than either, and one that a moving object fools (a restart in stop-and-go traffic
   // registered 0.26 m short, 0.12-0.26 m from the tracked step) keeps the looser sigma. 0.01 m over
   // 0.015 and 0.02 m for all pairs on the whole suite, five samples (docs/accuracy.md, "Scan pairs
