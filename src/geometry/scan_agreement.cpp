@@ -55,16 +55,25 @@ bool ScanAgreement::lands(const Eigen::Vector3f& p) const {
   constexpr float kFar = 1e5F;
   if (!(p.cwiseAbs().maxCoeff() < kFar)) return false;
   // the block's lowest voxel: p - tolerance lies in it on every axis, p + tolerance in the one above
-  const VoxelKey low = voxel_of(Eigen::Vector3f(p.array() - tolerance_), 0.5F / tolerance_);
+  const float inv = 0.5F / tolerance_;
+  const VoxelKey low = voxel_of(Eigen::Vector3f(p.array() - tolerance_), inv);
   const float tolerance2 = tolerance_ * tolerance_;
+  const auto near_in = [&](const VoxelKey& key) {
+    const std::uint32_t slot = reference_.index.find(key);
+    if (slot == VoxelIndex::npos) return false;
+    for (std::uint32_t j = reference_.begin[slot]; j < reference_.begin[slot + 1]; ++j) {
+      if ((reference_.points[j] - p).squaredNorm() <= tolerance2) return true;
+    }
+    return false;
+  };
+  // p's own voxel first: a point that lands mostly lands there, and the search ends
+  const VoxelKey own = voxel_of(p, inv);
+  if (near_in(own)) return true;
   for (int dx = 0; dx <= 1; ++dx) {
     for (int dy = 0; dy <= 1; ++dy) {
       for (int dz = 0; dz <= 1; ++dz) {
-        const std::uint32_t slot = reference_.index.find({low.x + dx, low.y + dy, low.z + dz});
-        if (slot == VoxelIndex::npos) continue;
-        for (std::uint32_t j = reference_.begin[slot]; j < reference_.begin[slot + 1]; ++j) {
-          if ((reference_.points[j] - p).squaredNorm() <= tolerance2) return true;
-        }
+        const VoxelKey key{low.x + dx, low.y + dy, low.z + dz};
+        if (!(key == own) && near_in(key)) return true;
       }
     }
   }

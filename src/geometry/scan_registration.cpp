@@ -81,33 +81,43 @@ class PlaneGrid {
     fit_planes(options);
   }
 
-  // The nearest reference point with a plane within max_distance of p: its index, or -1.
-  int nearest(const Eigen::Vector3f& p, float max_distance) const {
-    int best = -1;
-    float best2 = max_distance * max_distance;
-    for_neighbours(p, [&](std::uint32_t j) {
-      if (!has_plane_[j]) return;
-      const float d2 = (grid_.points[j] - p).squaredNorm();
-      if (d2 < best2) {
-        best2 = d2;
-        best = static_cast<int>(j);
-      }
+  // Appends the reference points with a plane within `radius` (at most edge()) of p, by voxel.
+  void gather(const Eigen::Vector3f& p, float radius, std::vector<std::uint32_t>& out) const {
+    const float radius2 = radius * radius;
+    for_neighbours(p, radius, [&](std::uint32_t j) {
+      if (has_plane_[j] && (grid_.points[j] - p).squaredNorm() <= radius2) out.push_back(j);
     });
-    return best;
   }
+  float edge() const { return 1.0F / inv_; }
 
   const Eigen::Vector3f& point(int j) const { return grid_.points[static_cast<std::size_t>(j)]; }
   const Eigen::Vector3f& normal(int j) const { return normals_[static_cast<std::size_t>(j)]; }
 
  private:
+  // Visits the points of the 3x3x3 voxels around p that come within `radius` (at most the edge) of it.
   template <typename Visit>
-  void for_neighbours(const Eigen::Vector3f& p, Visit&& visit) const {
+  void for_neighbours(const Eigen::Vector3f& p, float radius, Visit&& visit) const {
     constexpr float kFar = 1e5F;  // a pose gone wild: nothing near, and voxel keys stay in range
     if (!(p.cwiseAbs().maxCoeff() < kFar)) return;
     const VoxelKey c = voxel_of(p, inv_);
+    // p's distance to its voxel's faces, below and above: the gap to a neighbour voxel along an axis
+    const float edge = 1.0F / inv_;
+    const Eigen::Vector3f below =
+        p - edge * Eigen::Vector3f(static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z));
+    const Eigen::Vector3f above = Eigen::Vector3f::Constant(edge) - below;
+    const auto gap2 = [&](int d, int axis) {
+      const float g = d < 0 ? below[axis] : d > 0 ? above[axis] : 0.0F;
+      return g * g;
+    };
+    // a corner or edge voxel may lie wholly beyond the radius (rounding kept on the safe side)
+    const float reach2 = radius * radius * 1.0001F + 1e-6F;
     for (int dx = -1; dx <= 1; ++dx) {
+      const float gx = gap2(dx, 0);
       for (int dy = -1; dy <= 1; ++dy) {
+        const float gxy = gx + gap2(dy, 1);
+        if (gxy > reach2) continue;
         for (int dz = -1; dz <= 1; ++dz) {
+          if (gxy + gap2(dz, 2) > reach2) continue;
           const std::uint32_t slot = grid_.index.find({c.x + dx, c.y + dy, c.z + dz});
           if (slot == VoxelIndex::npos) continue;
           for (std::uint32_t j = grid_.begin[slot]; j < grid_.begin[slot + 1]; ++j) visit(j);
@@ -116,24 +126,57 @@ class PlaneGrid {
     }
   }
 
+  // A point's plane: the least-squares plane of its neighbours within normal_radius (itself included).
+  // Neighbourhood is symmetric, so each pair of points is measured once, voxel against voxel: a voxel,
+  // then each of the 13 neighbours that follow it (the other 13 see it as theirs).
   void fit_planes(const ScanRegistrationOptions& options) {
     const auto radius2 = static_cast<float>(options.normal_radius * options.normal_radius);
-    normals_.assign(grid_.points.size(), Eigen::Vector3f::Zero());
-    has_plane_.assign(grid_.points.size(), false);
-    for (std::size_t i = 0; i < grid_.points.size(); ++i) {
-      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-      Eigen::Matrix3f outer = Eigen::Matrix3f::Zero();
-      int n = 0;
-      for_neighbours(grid_.points[i], [&](std::uint32_t j) {
-        const Eigen::Vector3f d = grid_.points[j] - grid_.points[i];  // about the point: better conditioned
-        if (d.squaredNorm() > radius2) return;
-        sum += d;
-        outer += d * d.transpose();
-        ++n;
-      });
-      if (n < options.min_normal_points) continue;
-      const Eigen::Vector3f mean = sum / static_cast<float>(n);
-      const Eigen::Matrix3f covariance = outer / static_cast<float>(n) - mean * mean.transpose();
+    const std::size_t count = grid_.points.size();
+    // per point: the sum of the offsets to its neighbours, and of their outer products (xx xy xz yy yz zz)
+    std::vector<Eigen::Vector3f> sums(count, Eigen::Vector3f::Zero());
+    std::vector<Eigen::Matrix<float, 6, 1>> outers(count, Eigen::Matrix<float, 6, 1>::Zero());
+    std::vector<int> neighbours(count, 1);
+    const auto pair = [&](std::uint32_t i, std::uint32_t j) {
+      const Eigen::Vector3f d = grid_.points[j] - grid_.points[i];
+      if (d.squaredNorm() > radius2) return;
+      Eigen::Matrix<float, 6, 1> o;
+      o << d.x() * d.x(), d.x() * d.y(), d.x() * d.z(), d.y() * d.y(), d.y() * d.z(), d.z() * d.z();
+      sums[i] += d;
+      sums[j] -= d;
+      outers[i] += o;
+      outers[j] += o;
+      ++neighbours[i];
+      ++neighbours[j];
+    };
+    const std::size_t voxels = grid_.begin.size() - 1;
+    for (std::size_t slot = 0; slot < voxels; ++slot) {
+      const std::uint32_t a0 = grid_.begin[slot], a1 = grid_.begin[slot + 1];
+      for (std::uint32_t i = a0; i < a1; ++i) {
+        for (std::uint32_t j = i + 1; j < a1; ++j) pair(i, j);
+      }
+      const VoxelKey c = voxel_of(grid_.points[a0], inv_);
+      for (int dx = 0; dx <= 1; ++dx) {
+        for (int dy = dx == 0 ? 0 : -1; dy <= 1; ++dy) {
+          for (int dz = (dx == 0 && dy == 0) ? 1 : -1; dz <= 1; ++dz) {
+            const std::uint32_t other = grid_.index.find({c.x + dx, c.y + dy, c.z + dz});
+            if (other == VoxelIndex::npos) continue;
+            for (std::uint32_t i = a0; i < a1; ++i) {
+              for (std::uint32_t j = grid_.begin[other]; j < grid_.begin[other + 1]; ++j) pair(i, j);
+            }
+          }
+        }
+      }
+    }
+    normals_.assign(count, Eigen::Vector3f::Zero());
+    has_plane_.assign(count, false);
+    for (std::size_t i = 0; i < count; ++i) {
+      if (neighbours[i] < options.min_normal_points) continue;
+      const auto n = static_cast<float>(neighbours[i]);
+      const Eigen::Vector3f mean = sums[i] / n;
+      const Eigen::Matrix<float, 6, 1>& o = outers[i];
+      Eigen::Matrix3f outer;
+      outer << o[0], o[1], o[2], o[1], o[3], o[4], o[2], o[4], o[5];
+      const Eigen::Matrix3f covariance = outer / n - mean * mean.transpose();
       const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver(covariance);
       if (solver.info() != Eigen::Success) continue;
       normals_[i] = solver.eigenvectors().col(0);  // smallest eigenvalue first
@@ -169,16 +212,53 @@ std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, co
   const double scale2 = options.robust_scale * options.robust_scale;
   IcpRun run;
   run.T = guess;
+  // A query point moves little from one iteration to the next, so each keeps the reference points
+  // within `reach` of where it was last searched (its anchor) and, while it stays within reach -
+  // max_distance of the anchor, searches those alone: they hold every point within max_distance of it.
+  // The same nearest point as a search of the grid, found among a handful instead of a hundred.
+  struct Neighbourhood {
+    Eigen::Vector3f anchor = Eigen::Vector3f::Zero();
+    float reach = -1.0F;  // none yet
+    std::uint32_t begin = 0, end = 0;
+  };
+  std::vector<Neighbourhood> cache(query.points.size());
+  std::vector<std::uint32_t> pool;  // the neighbourhoods' points
+  const std::size_t pool_limit = 64 * query.points.size() + 1024;
+  // how far a point may move before it is searched again: of 1/3, 2/3 and 3/2 of fine_distance, 2/3
+  // registered 04's keyframe pairs fastest (fewer searches against more points per search)
+  const auto slack = static_cast<float>(2.0 / 3.0 * options.fine_distance);
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     const auto max_distance =
         static_cast<float>(iteration < options.coarse_iterations ? options.coarse_distance : options.fine_distance);
+    const float reach = std::min(grid.edge(), max_distance + slack);
+    const float max2 = max_distance * max_distance;
+    if (pool.size() > pool_limit) {  // regathered often (a guess far off): start again
+      pool.clear();
+      for (Neighbourhood& hood : cache) hood.reach = -1.0F;
+    }
     const Eigen::Isometry3f Tf = run.T.cast<float>();
     Matrix6d H = Matrix6d::Zero();
     Vector6d g = Vector6d::Zero();
     std::size_t used = 0;
-    for (const Eigen::Vector3f& q : query.points) {
-      const Eigen::Vector3f x = Tf * q;
-      const int j = grid.nearest(x, max_distance);
+    for (std::size_t i = 0; i < query.points.size(); ++i) {
+      const Eigen::Vector3f x = Tf * query.points[i];
+      Neighbourhood& hood = cache[i];
+      if (!((x - hood.anchor).norm() + max_distance <= hood.reach)) {
+        hood.anchor = x;
+        hood.reach = reach;
+        hood.begin = static_cast<std::uint32_t>(pool.size());
+        grid.gather(x, reach, pool);
+        hood.end = static_cast<std::uint32_t>(pool.size());
+      }
+      int j = -1;
+      float best2 = max2;
+      for (std::uint32_t k = hood.begin; k < hood.end; ++k) {
+        const float d2 = (grid.point(static_cast<int>(pool[k])) - x).squaredNorm();
+        if (d2 < best2) {
+          best2 = d2;
+          j = static_cast<int>(pool[k]);
+        }
+      }
       if (j < 0) continue;
       const Eigen::Vector3d n = grid.normal(j).cast<double>();
       const Eigen::Vector3d xd = x.cast<double>();
@@ -217,7 +297,9 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
   const ScanSample query_points = voxel_downsample(query, options, options.query_voxel);
   const PlaneGrid grid(reference_points, options);
   // the agreement is counted on the query at the reference's density
-  const ScanSample dense = voxel_downsample(query, options, options.reference_voxel);
+  const bool same_voxel = options.query_voxel == options.reference_voxel;
+  const ScanSample finer = same_voxel ? ScanSample{} : voxel_downsample(query, options, options.reference_voxel);
+  const ScanSample& dense = same_voxel ? query_points : finer;
   const ScanAgreement agreement(reference_points, options.agreement_tolerance);
   const auto share = [&](const Eigen::Isometry3d& T) { return landing_share(agreement, dense, T); };
 
@@ -281,13 +363,19 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
   struct Candidate {
     IcpRun run;
     double agreement = 0.0;
+    std::size_t landing = 0;  // of `dense`'s points
   };
   std::vector<Candidate> converged;
   std::optional<IcpRun> first;  // the first seed's run, reported when nothing converges
   for (const Eigen::Isometry3d& seed : seeds) {
     const auto run = run_icp(grid, query_points, seed, options);
     if (run && !first) first = run;
-    if (run && run->converged) converged.push_back({*run, share(run->T)});
+    if (run && run->converged) {
+      const std::size_t landing = agreement.count(dense, run->T);
+      const double agreement_share =
+          dense.empty() ? 0.0 : static_cast<double>(landing) / static_cast<double>(dense.points.size());
+      converged.push_back({*run, agreement_share, landing});
+    }
   }
   if (converged.empty() && !first) return std::nullopt;
 
@@ -314,7 +402,7 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
   }
 
   // The probe: moved along each axis of the reference, the result must lose landing points.
-  const std::size_t at_result = agreement.count(dense, result.T_reference_query);
+  const std::size_t at_result = best->landing;
   result.min_probe_loss = at_result == 0 ? 0.0 : 1.0;
   for (int axis = 0; axis < 3 && at_result > 0; ++axis) {
     for (const double sign : {-1.0, 1.0}) {
