@@ -81,6 +81,21 @@ class PlaneGrid {
     fit_planes(options);
   }
 
+  // The nearest reference point with a plane within max_distance (at most edge()) of p: its index, or -1.
+  int nearest(const Eigen::Vector3f& p, float max_distance) const {
+    int best = -1;
+    float best2 = max_distance * max_distance;
+    for_neighbours(p, max_distance, [&](std::uint32_t j) {
+      if (!has_plane_[j]) return;
+      const float d2 = (grid_.points[j] - p).squaredNorm();
+      if (d2 < best2) {
+        best2 = d2;
+        best = static_cast<int>(j);
+      }
+    });
+    return best;
+  }
+
   // Appends the reference points with a plane within `radius` (at most edge()) of p, by voxel.
   void gather(const Eigen::Vector3f& p, float radius, std::vector<std::uint32_t>& out) const {
     const float radius2 = radius * radius;
@@ -230,7 +245,10 @@ std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, co
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     const auto max_distance =
         static_cast<float>(iteration < options.coarse_iterations ? options.coarse_distance : options.fine_distance);
+    // the voxels reach no further than the correspondences (a coarse distance as long as the voxel's
+    // edge, as across a gap): no room to move, so a plain search
     const float reach = std::min(grid.edge(), max_distance + slack);
+    const bool keep = reach >= max_distance + 0.5F * slack;
     const float max2 = max_distance * max_distance;
     if (pool.size() > pool_limit) {  // regathered often (a guess far off): start again
       pool.clear();
@@ -240,8 +258,26 @@ std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, co
     Matrix6d H = Matrix6d::Zero();
     Vector6d g = Vector6d::Zero();
     std::size_t used = 0;
+    // the point-to-plane residual of query point x (in the reference's frame) against reference point j
+    const auto add = [&](const Eigen::Vector3f& x, int j) {
+      const Eigen::Vector3d n = grid.normal(j).cast<double>();
+      const Eigen::Vector3d xd = x.cast<double>();
+      const double r = n.dot(xd - grid.point(j).cast<double>());
+      // d(n . (exp(xi) x)) / d[rho; phi] at 0 = [n; x x n]
+      Vector6d J;
+      J << n, xd.cross(n);
+      const double w = 1.0 / (1.0 + r * r / scale2);
+      H.noalias() += w * J * J.transpose();
+      g.noalias() += w * r * J;
+      ++used;
+    };
     for (std::size_t i = 0; i < query.points.size(); ++i) {
       const Eigen::Vector3f x = Tf * query.points[i];
+      if (!keep) {
+        const int j = grid.nearest(x, max_distance);
+        if (j >= 0) add(x, j);
+        continue;
+      }
       Neighbourhood& hood = cache[i];
       if (!((x - hood.anchor).norm() + max_distance <= hood.reach)) {
         hood.anchor = x;
@@ -259,17 +295,7 @@ std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, co
           j = static_cast<int>(pool[k]);
         }
       }
-      if (j < 0) continue;
-      const Eigen::Vector3d n = grid.normal(j).cast<double>();
-      const Eigen::Vector3d xd = x.cast<double>();
-      const double r = n.dot(xd - grid.point(j).cast<double>());
-      // d(n . (exp(xi) x)) / d[rho; phi] at 0 = [n; x x n]
-      Vector6d J;
-      J << n, xd.cross(n);
-      const double w = 1.0 / (1.0 + r * r / scale2);
-      H.noalias() += w * J * J.transpose();
-      g.noalias() += w * r * J;
-      ++used;
+      if (j >= 0) add(x, j);
     }
     run.correspondences = used;
     run.iterations = iteration + 1;
