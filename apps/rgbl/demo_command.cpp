@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -41,6 +42,15 @@ void print_scenarios() {
   }
 }
 
+// The command-line option that sets DemoOptions' `key` (lap_offset: --lap-offset).
+std::string option_name(const std::string& key) {
+  if (key == "lidar_elevation_offset_deg") return "--lidar-elevation-offset";
+  if (key == "lidar_beam_error_deg") return "--lidar-beam-error";
+  std::string name = "--" + key;
+  std::replace(name.begin(), name.end(), '_', '-');
+  return name;
+}
+
 int run_demo(const DemoArgs& args, bool quiet) {
   if (args.demo.scenario == "list") {
     print_scenarios();
@@ -51,7 +61,7 @@ int run_demo(const DemoArgs& args, bool quiet) {
   try {
     sim = demo_simulation(demo);
   } catch (const ConfigError& e) {
-    throw ConfigError("--" + e.key(), e.expected());  // DemoOptions' keys are the options' names
+    throw ConfigError(option_name(e.key()), e.expected());
   }
 
   std::optional<TemporaryFolder> temp;
@@ -138,6 +148,13 @@ Command add_demo_command(CLI::App& parent) {
   app->add_option("--lap-offset", args->demo.lap_offset,
                   "Metres right (+) or left (-) of the first lap for the later laps of --path loop (-3.3: the "
                   "next lane to the left), reached by a lane change ending 10 m before the start")
+      ->capture_default_str();
+  app->add_option("--lidar-elevation-offset", args->demo.lidar_elevation_offset_deg,
+                  "Every LiDAR beam fires this much higher than its nominal elevation, deg (the points keep the "
+                  "nominal one; 0.2 makes the scan pairs pitch as KITTI's do)")
+      ->capture_default_str();
+  app->add_option("--lidar-beam-error", args->demo.lidar_beam_error_deg,
+                  "Sigma of each LiDAR beam's own elevation error, deg (drawn once per beam and seed)")
       ->capture_default_str();
   app->add_flag("--threaded", args->demo.threaded, "Local mapping and loop closing in threads of their own");
   app->add_flag_callback("--no-loop-closing", [args] { args->demo.loop_closing = false; }, "Track without loop closing (to compare)");

@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 namespace rgbl {
 
 void DemoOptions::validate() const {
@@ -19,6 +21,11 @@ void DemoOptions::validate() const {
   if (lap_offset != 0.0 && laps < 2) {
     throw ConfigError("lap_offset", "0 unless a loop of 2 or more laps is driven (the offset is the later laps')");
   }
+  // the simulator's own bounds, named by the demo's keys
+  require(std::isfinite(lidar_elevation_offset_deg) && std::abs(lidar_elevation_offset_deg) <= 2.0,
+          "lidar_elevation_offset_deg", "an angle within +-2 deg");
+  require(std::isfinite(lidar_beam_error_deg) && lidar_beam_error_deg >= 0.0 && lidar_beam_error_deg <= 2.0,
+          "lidar_beam_error_deg", "a sigma in [0, 2] deg");
   // refused before any generation time is spent on it
   if (builtin_depth_sources().entry(depth).needs.depth_image) {
     throw ConfigError("depth", fmt::format("lidar[:...], stereo or precomputed[:<dir>] for the demo's KITTI layout "
@@ -39,6 +46,8 @@ SyntheticOptions demo_simulation(const DemoOptions& options) {
     sim.path.kind = *parse_path_kind(options.path);
   }
   sim.depth_camera = 0;  // the exact depth of the camera the pipeline tracks
+  sim.lidar.elevation_offset_deg = options.lidar_elevation_offset_deg;
+  sim.lidar.beam_elevation_sigma_deg = options.lidar_beam_error_deg;
   if (sim.path.kind == PathKind::loop) {
     fit_loop(sim, options.laps);
     sim.path.loop_lap_offset = options.lap_offset;

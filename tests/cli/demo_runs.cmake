@@ -34,4 +34,12 @@ execute_process(COMMAND ${RGBL} demo --depth rgbd RESULT_VARIABLE rc ERROR_VARIA
 if(rc EQUAL 0 OR NOT err MATCHES "^error: invalid option '--depth'")
   message(FATAL_ERROR "--depth rgbd: expected an error naming --depth, got exit ${rc}: ${err}")
 endif()
+# named as the options are spelled, not as DemoOptions' keys
+foreach(case "--lidar-elevation-offset;5" "--lidar-beam-error;-0.1" "--lap-offset;2")
+  list(GET case 0 option)
+  execute_process(COMMAND ${RGBL} demo ${case} RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR NOT err MATCHES "^error: invalid option '${option}'")
+    message(FATAL_ERROR "${case}: expected an error naming ${option}, got exit ${rc}: ${err}")
+  endif()
+endforeach()
 file(REMOVE_RECURSE ${WORK_DIR})

@@ -512,6 +512,13 @@ TEST_CASE("the demo as a library: a scenario or a path, only the sensors its dep
   CHECK(two_laps.path.loop_lap_offset == 0.0);
   loop.lap_offset = -3.3;
   CHECK(rgbl::demo_simulation(loop).path.loop_lap_offset == -3.3);
+  CHECK(scenario.lidar.elevation_offset_deg == 0.0);  // exact beams unless asked
+  CHECK(scenario.lidar.beam_elevation_sigma_deg == 0.0);
+  demo.lidar_elevation_offset_deg = 0.2;
+  demo.lidar_beam_error_deg = 0.05;
+  const rgbl::SyntheticOptions miscalibrated = rgbl::demo_simulation(demo);
+  CHECK(miscalibrated.lidar.elevation_offset_deg == 0.2);
+  CHECK(miscalibrated.lidar.beam_elevation_sigma_deg == 0.05);
 
   // every refusal names the key, before anything is generated
   const auto refused = [](rgbl::DemoOptions o, const char* key) {
@@ -537,6 +544,12 @@ TEST_CASE("the demo as a library: a scenario or a path, only the sensors its dep
   bad = {};
   bad.frames = -1;
   refused(bad, "frames");
+  bad = {};
+  bad.lidar_elevation_offset_deg = 3.0;
+  refused(bad, "lidar_elevation_offset_deg");
+  bad = {};
+  bad.lidar_beam_error_deg = -0.1;
+  refused(bad, "lidar_beam_error_deg");
   bad = {};
   bad.path = "loop";
   bad.lap_offset = -3.3;  // one lap has no later laps

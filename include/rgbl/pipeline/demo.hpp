@@ -25,8 +25,15 @@ struct DemoOptions {
   std::string depth = "lidar";
   bool threaded = false;
   bool loop_closing = true;
+  // The LiDAR's intrinsic calibration error (SimLidarOptions): every beam fires this much higher than
+  // its nominal elevation, and each beam by its own Gaussian error of this sigma on top, while the
+  // points keep the nominal elevations, as a real HDL-64's do (0.2 deg reproduces the pitch of KITTI's
+  // scan pairs: docs/synthetic.md). 0 and 0: exact beams, as the accuracy suite's scenarios.
+  double lidar_elevation_offset_deg = 0.0;
+  double lidar_beam_error_deg = 0.0;
 
-  // Throws ConfigError naming the key (scenario, path, frames, laps, lap_offset, depth).
+  // Throws ConfigError naming the key (scenario, path, frames, laps, lap_offset, depth,
+  // lidar_elevation_offset_deg, lidar_beam_error_deg).
   void validate() const;
 };
 
