@@ -71,29 +71,20 @@ ScanSample voxel_downsample(PointCloudView scan, const ScanRegistrationOptions& 
   return sample;
 }
 
-// Reference points with their planes, grouped by voxels of edge `edge` for neighbour searches within
-// that distance (the 3x3x3 block around a point holds them all).
+// How far an ICP query point may move before its neighbourhood is searched again: of 1/3, 2/3 and 3/2
+// of fine_distance, 2/3 registered 04's keyframe pairs fastest (fewer searches against more points each).
+double search_slack(const ScanRegistrationOptions& options) { return 2.0 / 3.0 * options.fine_distance; }
+
+// Reference points with their planes, grouped by voxels for neighbour searches within their edge (the
+// 3x3x3 block around a point holds them all): the plane's radius, or the coarse correspondence distance
+// plus the slack, so that even the coarse iterations keep their neighbourhoods.
 class PlaneGrid {
  public:
   PlaneGrid(const ScanSample& points, const ScanRegistrationOptions& options)
-      : inv_(1.0F / static_cast<float>(std::max(options.coarse_distance, options.normal_radius))),
+      : inv_(1.0F / static_cast<float>(
+                        std::max(options.coarse_distance + search_slack(options), options.normal_radius))),
         grid_(points.points, inv_) {
     fit_planes(options);
-  }
-
-  // The nearest reference point with a plane within max_distance (at most edge()) of p: its index, or -1.
-  int nearest(const Eigen::Vector3f& p, float max_distance) const {
-    int best = -1;
-    float best2 = max_distance * max_distance;
-    for_neighbours(p, max_distance, [&](std::uint32_t j) {
-      if (!has_plane_[j]) return;
-      const float d2 = (grid_.points[j] - p).squaredNorm();
-      if (d2 < best2) {
-        best2 = d2;
-        best = static_cast<int>(j);
-      }
-    });
-    return best;
   }
 
   // Appends the reference points with a plane within `radius` (at most edge()) of p, by voxel.
@@ -239,16 +230,11 @@ std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, co
   std::vector<Neighbourhood> cache(query.points.size());
   std::vector<std::uint32_t> pool;  // the neighbourhoods' points
   const std::size_t pool_limit = 64 * query.points.size() + 1024;
-  // how far a point may move before it is searched again: of 1/3, 2/3 and 3/2 of fine_distance, 2/3
-  // registered 04's keyframe pairs fastest (fewer searches against more points per search)
-  const auto slack = static_cast<float>(2.0 / 3.0 * options.fine_distance);
+  const auto slack = static_cast<float>(search_slack(options));
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     const auto max_distance =
         static_cast<float>(iteration < options.coarse_iterations ? options.coarse_distance : options.fine_distance);
-    // the voxels reach no further than the correspondences (a coarse distance as long as the voxel's
-    // edge, as across a gap): no room to move, so a plain search
-    const float reach = std::min(grid.edge(), max_distance + slack);
-    const bool keep = reach >= max_distance + 0.5F * slack;
+    const float reach = std::min(grid.edge(), max_distance + slack);  // the edge holds max_distance + slack
     const float max2 = max_distance * max_distance;
     if (pool.size() > pool_limit) {  // regathered often (a guess far off): start again
       pool.clear();
@@ -273,11 +259,6 @@ std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, co
     };
     for (std::size_t i = 0; i < query.points.size(); ++i) {
       const Eigen::Vector3f x = Tf * query.points[i];
-      if (!keep) {
-        const int j = grid.nearest(x, max_distance);
-        if (j >= 0) add(x, j);
-        continue;
-      }
       Neighbourhood& hood = cache[i];
       if (!((x - hood.anchor).norm() + max_distance <= hood.reach)) {
         hood.anchor = x;
