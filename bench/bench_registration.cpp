@@ -21,11 +21,8 @@ struct KeyframePair {
   KeyframePair() : reference(sample(0)), query(sample(3)) { guess.translation() = Eigen::Vector3d(0.0, 0.0, 4.0); }
 
   static std::vector<rgbl::LidarPoint> sample(int frame) {
-    const rgbl::ScanSample s =
-        rgbl::sample_scan(rgbl::bench::scan(frame), rgbl::bench::calibration().T_cam0_lidar, rgbl::ScanSampleOptions{});
-    std::vector<rgbl::LidarPoint> points;
-    for (const Eigen::Vector3f& p : s.points) points.push_back({p.x(), p.y(), p.z(), 0.0F});
-    return points;
+    return rgbl::as_points(
+        rgbl::sample_scan(rgbl::bench::scan(frame), rgbl::bench::calibration().T_cam0_lidar, rgbl::ScanSampleOptions{}));
   }
 };
 

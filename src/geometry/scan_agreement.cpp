@@ -43,6 +43,16 @@ ScanSample sample_scan(PointCloudView scan, const Eigen::Isometry3d& T_cam_lidar
   return sample;
 }
 
+std::vector<LidarPoint> as_points(const ScanSample& sample) {
+  std::vector<LidarPoint> points(sample.points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    points[i].x = sample.points[i].x();
+    points[i].y = sample.points[i].y();
+    points[i].z = sample.points[i].z();
+  }
+  return points;
+}
+
 ScanAgreement::ScanAgreement(const ScanSample& reference, double tolerance)
     : tolerance_(static_cast<float>(tolerance)),
       // Voxels of twice the tolerance: every point within the tolerance of a query lies in the 2x2x2
@@ -55,25 +65,16 @@ bool ScanAgreement::lands(const Eigen::Vector3f& p) const {
   constexpr float kFar = 1e5F;
   if (!(p.cwiseAbs().maxCoeff() < kFar)) return false;
   // the block's lowest voxel: p - tolerance lies in it on every axis, p + tolerance in the one above
-  const float inv = 0.5F / tolerance_;
-  const VoxelKey low = voxel_of(Eigen::Vector3f(p.array() - tolerance_), inv);
+  const VoxelKey low = voxel_of(Eigen::Vector3f(p.array() - tolerance_), 0.5F / tolerance_);
   const float tolerance2 = tolerance_ * tolerance_;
-  const auto near_in = [&](const VoxelKey& key) {
-    const std::uint32_t slot = reference_.index.find(key);
-    if (slot == VoxelIndex::npos) return false;
-    for (std::uint32_t j = reference_.begin[slot]; j < reference_.begin[slot + 1]; ++j) {
-      if ((reference_.points[j] - p).squaredNorm() <= tolerance2) return true;
-    }
-    return false;
-  };
-  // p's own voxel first: a point that lands mostly lands there, and the search ends
-  const VoxelKey own = voxel_of(p, inv);
-  if (near_in(own)) return true;
   for (int dx = 0; dx <= 1; ++dx) {
     for (int dy = 0; dy <= 1; ++dy) {
       for (int dz = 0; dz <= 1; ++dz) {
-        const VoxelKey key{low.x + dx, low.y + dy, low.z + dz};
-        if (!(key == own) && near_in(key)) return true;
+        const std::uint32_t slot = reference_.index.find({low.x + dx, low.y + dy, low.z + dz});
+        if (slot == VoxelIndex::npos) continue;
+        for (std::uint32_t j = reference_.begin[slot]; j < reference_.begin[slot + 1]; ++j) {
+          if ((reference_.points[j] - p).squaredNorm() <= tolerance2) return true;
+        }
       }
     }
   }

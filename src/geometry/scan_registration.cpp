@@ -72,7 +72,8 @@ ScanSample voxel_downsample(PointCloudView scan, const ScanRegistrationOptions& 
 }
 
 // How far an ICP query point may move before its neighbourhood is searched again: of 1/3, 2/3 and 3/2
-// of fine_distance, 2/3 registered 04's keyframe pairs fastest (fewer searches against more points each).
+// of fine_distance, 2/3 registered three of 04's keyframe pairs fastest on average (fewer searches
+// against more points each).
 double search_slack(const ScanRegistrationOptions& options) { return 2.0 / 3.0 * options.fine_distance; }
 
 // Reference points with their planes, grouped by voxels for neighbour searches within their edge (the
@@ -89,10 +90,21 @@ class PlaneGrid {
 
   // Appends the reference points with a plane within `radius` (at most edge()) of p, by voxel.
   void gather(const Eigen::Vector3f& p, float radius, std::vector<std::uint32_t>& out) const {
+    constexpr float kFar = 1e5F;  // a pose gone wild: nothing near, and voxel keys stay in range
+    if (!(p.cwiseAbs().maxCoeff() < kFar)) return;
     const float radius2 = radius * radius;
-    for_neighbours(p, radius, [&](std::uint32_t j) {
-      if (has_plane_[j] && (grid_.points[j] - p).squaredNorm() <= radius2) out.push_back(j);
-    });
+    const VoxelKey c = voxel_of(p, inv_);
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          const std::uint32_t slot = grid_.index.find({c.x + dx, c.y + dy, c.z + dz});
+          if (slot == VoxelIndex::npos) continue;
+          for (std::uint32_t j = grid_.begin[slot]; j < grid_.begin[slot + 1]; ++j) {
+            if (has_plane_[j] && (grid_.points[j] - p).squaredNorm() <= radius2) out.push_back(j);
+          }
+        }
+      }
+    }
   }
   float edge() const { return 1.0F / inv_; }
 
@@ -100,38 +112,6 @@ class PlaneGrid {
   const Eigen::Vector3f& normal(int j) const { return normals_[static_cast<std::size_t>(j)]; }
 
  private:
-  // Visits the points of the 3x3x3 voxels around p that come within `radius` (at most the edge) of it.
-  template <typename Visit>
-  void for_neighbours(const Eigen::Vector3f& p, float radius, Visit&& visit) const {
-    constexpr float kFar = 1e5F;  // a pose gone wild: nothing near, and voxel keys stay in range
-    if (!(p.cwiseAbs().maxCoeff() < kFar)) return;
-    const VoxelKey c = voxel_of(p, inv_);
-    // p's distance to its voxel's faces, below and above: the gap to a neighbour voxel along an axis
-    const float edge = 1.0F / inv_;
-    const Eigen::Vector3f below =
-        p - edge * Eigen::Vector3f(static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z));
-    const Eigen::Vector3f above = Eigen::Vector3f::Constant(edge) - below;
-    const auto gap2 = [&](int d, int axis) {
-      const float g = d < 0 ? below[axis] : d > 0 ? above[axis] : 0.0F;
-      return g * g;
-    };
-    // a corner or edge voxel may lie wholly beyond the radius (rounding kept on the safe side)
-    const float reach2 = radius * radius * 1.0001F + 1e-6F;
-    for (int dx = -1; dx <= 1; ++dx) {
-      const float gx = gap2(dx, 0);
-      for (int dy = -1; dy <= 1; ++dy) {
-        const float gxy = gx + gap2(dy, 1);
-        if (gxy > reach2) continue;
-        for (int dz = -1; dz <= 1; ++dz) {
-          if (gxy + gap2(dz, 2) > reach2) continue;
-          const std::uint32_t slot = grid_.index.find({c.x + dx, c.y + dy, c.z + dz});
-          if (slot == VoxelIndex::npos) continue;
-          for (std::uint32_t j = grid_.begin[slot]; j < grid_.begin[slot + 1]; ++j) visit(j);
-        }
-      }
-    }
-  }
-
   // A point's plane: the least-squares plane of its neighbours within normal_radius (itself included).
   // Neighbourhood is symmetric, so each pair of points is measured once, voxel against voxel: a voxel,
   // then each of the 13 neighbours that follow it (the other 13 see it as theirs).
@@ -197,9 +177,11 @@ class PlaneGrid {
 };
 
 // The share of `sample`'s points that land on the reference under T (0 for an empty sample).
+double share_of(std::size_t landing, const ScanSample& sample) {
+  return sample.empty() ? 0.0 : static_cast<double>(landing) / static_cast<double>(sample.points.size());
+}
 double landing_share(const ScanAgreement& agreement, const ScanSample& sample, const Eigen::Isometry3d& T) {
-  if (sample.empty()) return 0.0;
-  return static_cast<double>(agreement.count(sample, T)) / static_cast<double>(sample.points.size());
+  return share_of(agreement.count(sample, T), sample);
 }
 
 // One ICP run from `guess`: the pose, whether it converged, the last iteration's correspondences and
@@ -308,7 +290,6 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
   const ScanSample finer = same_voxel ? ScanSample{} : voxel_downsample(query, options, options.reference_voxel);
   const ScanSample& dense = same_voxel ? query_points : finer;
   const ScanAgreement agreement(reference_points, options.agreement_tolerance);
-  const auto share = [&](const Eigen::Isometry3d& T) { return landing_share(agreement, dense, T); };
 
   // The starts: the guess moved along its own direction of travel by every multiple of along_step_m
   // within along_range_m (a car braking or speeding up in a gap), each turned about the query's
@@ -369,20 +350,14 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
 
   struct Candidate {
     IcpRun run;
-    double agreement = 0.0;
-    std::size_t landing = 0;  // of `dense`'s points
+    std::size_t landing = 0;  // of `dense`'s points: its agreement
   };
   std::vector<Candidate> converged;
   std::optional<IcpRun> first;  // the first seed's run, reported when nothing converges
   for (const Eigen::Isometry3d& seed : seeds) {
     const auto run = run_icp(grid, query_points, seed, options);
     if (run && !first) first = run;
-    if (run && run->converged) {
-      const std::size_t landing = agreement.count(dense, run->T);
-      const double agreement_share =
-          dense.empty() ? 0.0 : static_cast<double>(landing) / static_cast<double>(dense.points.size());
-      converged.push_back({*run, agreement_share, landing});
-    }
+    if (run && run->converged) converged.push_back({*run, agreement.count(dense, run->T)});
   }
   if (converged.empty() && !first) return std::nullopt;
 
@@ -393,19 +368,21 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
     result.T_reference_query = first->T;
     result.iterations = first->iterations;
     result.correspondences = first->correspondences;
-    result.agreement = share(first->T);
+    result.agreement = landing_share(agreement, dense, first->T);
     return result;  // not converged: no probe
   }
   const auto best = std::max_element(converged.begin(), converged.end(),
-                                     [](const Candidate& a, const Candidate& b) { return a.agreement < b.agreement; });
+                                     [](const Candidate& a, const Candidate& b) { return a.landing < b.landing; });
   result.T_reference_query = best->run.T;
   result.converged = true;
   result.iterations = best->run.iterations;
   result.correspondences = best->run.correspondences;
-  result.agreement = best->agreement;
+  result.agreement = share_of(best->landing, dense);
   // the best of the converged results elsewhere (another optimum, not the same one reached twice)
   for (const Candidate& c : converged) {
-    if (distinct(best->run.T, c.run.T)) result.runner_up_agreement = std::max(result.runner_up_agreement, c.agreement);
+    if (distinct(best->run.T, c.run.T)) {
+      result.runner_up_agreement = std::max(result.runner_up_agreement, share_of(c.landing, dense));
+    }
   }
 
   // The probe: moved along each axis of the reference, the result must lose landing points.

@@ -56,19 +56,6 @@ LocalMappingStats LocalMapper::process(KeyframeId keyframe, const std::vector<La
   return stats;
 }
 
-namespace {
-
-std::vector<LidarPoint> as_points(const ScanSample& sample) {
-  std::vector<LidarPoint> points(sample.points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    points[i].x = sample.points[i].x();
-    points[i].y = sample.points[i].y();
-    points[i].z = sample.points[i].z();
-  }
-  return points;
-}
-
-}  // namespace
 
 void LocalMapper::measure_lidar_pair(KeyframeId id) {
   std::shared_ptr<const ScanSample> scan, previous_scan;

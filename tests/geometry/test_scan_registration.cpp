@@ -2,6 +2,7 @@
 #include "rgbl/core/error.hpp"
 #include "rgbl/geometry/calibration.hpp"
 #include "rgbl/geometry/point_cloud.hpp"
+#include "rgbl/geometry/scan_agreement.hpp"
 #include "rgbl/geometry/scan_registration.hpp"
 #include "rgbl/geometry/se3.hpp"
 #include "rgbl/io/trajectory_io.hpp"
@@ -287,11 +288,8 @@ TEST_CASE("scan registration: the same result as the straightforward implementat
     if (!sequence) return;
     const rgbl::KittiCalibration calibration = rgbl::read_kitti_odometry_calibration(*sequence / "calib.txt");
     const auto sample = [&](int i) {
-      const rgbl::ScanSample s = rgbl::sample_scan(rgbl::read_kitti_scan(*sequence / "velodyne" / fmt::format("{:06d}.bin", i)),
-                                                   calibration.T_cam0_lidar, rgbl::ScanSampleOptions{});
-      std::vector<rgbl::LidarPoint> points;
-      for (const Eigen::Vector3f& p : s.points) points.push_back({p.x(), p.y(), p.z(), 0.0F});
-      return points;
+      return rgbl::as_points(rgbl::sample_scan(rgbl::read_kitti_scan(*sequence / "velodyne" / fmt::format("{:06d}.bin", i)),
+                                               calibration.T_cam0_lidar, rgbl::ScanSampleOptions{}));
     };
     // LocalMappingOptions::lidar_registration (tracking is above geometry: its values, restated)
     const rgbl::ScanRegistrationOptions pairs{.min_range = 2.0, .max_range = 40.0, .reference_voxel = 0.3,

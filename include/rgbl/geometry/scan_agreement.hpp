@@ -41,6 +41,9 @@ struct ScanSample {
 
 ScanSample sample_scan(PointCloudView scan, const Eigen::Isometry3d& T_cam_lidar, const ScanSampleOptions& options);
 
+// The sample's points as LiDAR returns (intensity 0), e.g. to register two samples (register_scans).
+std::vector<LidarPoint> as_points(const ScanSample& sample);
+
 // The objects of a sample: points whose voxels (of edge `edge`) touch, even at a corner, share a label
 // (labels 0..n-1 in order of first appearance). What is one object to the scan is one surface to a
 // pose: a truck's face, a facade, a pole; its returns land or miss together.
