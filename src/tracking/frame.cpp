@@ -19,6 +19,7 @@ FeatureExtractor make_orb_extractor(const OrbOptions& options, std::shared_ptr<T
 
 void TrackerOptions::validate() const {
   scan_sample.validate();
+  object_residuals.validate();
   require(std::isfinite(gap_interval_ratio) && gap_interval_ratio > 1.0, "tracker.gap_interval_ratio",
           "> 1 (times the last frame interval)");
   require(std::isfinite(max_gap_s) && max_gap_s > 0.0, "tracker.max_gap_s", "> 0 s");

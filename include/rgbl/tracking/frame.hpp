@@ -43,6 +43,9 @@ struct Frame {
   // motion and their depth-continuous neighbours (estimate_frame_motion). Empty = none known. They
   // are neither matched nor made landmarks.
   std::vector<bool> moving;
+  // Landmarks on objects whose residuals erred together (TrackerOptions::object_test): where the
+  // object was when it was mapped, no longer where it is. Erased when the frame's placement is taken.
+  std::vector<LandmarkId> moved_landmarks;
   Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();
   // A subsample of the frame's LiDAR scan in its camera frame (null without a scan): a second
   // opinion on poses that the images leave ambiguous. Shared, so copies of the frame are cheap.

@@ -6,6 +6,7 @@
 #include "rgbl/backend/depth_noise.hpp"
 #include "rgbl/backend/map_bundle.hpp"
 #include "rgbl/backend/pose_optimizer.hpp"
+#include "rgbl/tracking/object_residuals.hpp"
 #include "rgbl/geometry/scan_agreement.hpp"
 #include "rgbl/geometry/scan_registration.hpp"
 #include "rgbl/map/fusion.hpp"
@@ -99,6 +100,12 @@ struct TrackerOptions {
   // ...and keypoints with depth within moving_label_radius px of such a point, at a continuous depth,
   // share its label (0 = only the RANSAC's own points are labelled).
   double moving_label_radius = 24.0;       // px
+  // After each pose optimisation, objects (depth-continuous groups of inliers off the road) whose
+  // residuals err together are left out and the pose optimised again (object_residuals.hpp): a car
+  // ahead at about the ego speed stays inside every per-point gate. Their keypoints are labelled
+  // moving. Its grouping's defaults are moving_label_radius and the RANSAC's tolerances.
+  bool object_test = false;
+  ObjectResidualOptions object_residuals;
   double ground_min_height = 0.8;          // m below the camera
   double ground_max_tilt_deg = 20.0;
   double ground_tolerance = 0.1;           // m
