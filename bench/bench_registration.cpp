@@ -1,11 +1,13 @@
 #include "bench_data.hpp"
 #include "reference/scan_registration_reference.hpp"
+#include "rgbl/core/task_pool.hpp"
 #include "rgbl/geometry/scan_agreement.hpp"
 #include "rgbl/geometry/scan_registration.hpp"
 #include "rgbl/tracking/options.hpp"
 
 #include <benchmark/benchmark.h>
 
+#include <memory>
 #include <vector>
 
 namespace {
@@ -38,7 +40,30 @@ void scan_registration_reference(benchmark::State& state) {
   }
 }
 
+// A gap in the frames as the tracker registers it (TrackerOptions::gap_registration): sequence 04's
+// scans 14 and 35, 2.1 s apart, from a constant-velocity guess of 1.4 m per frame; the search covers
+// 91 starts. Inline, and on a pool of 2 threads (the calling one and one worker), as the pipeline
+// gives the tracker the pool that builds its frames.
+struct GapPair {
+  std::vector<rgbl::LidarPoint> reference = rgbl::bench::scan(14), query = rgbl::bench::scan(35);
+  Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
+  GapPair() { guess.translation() = Eigen::Vector3d(0.0, 0.0, 1.4 * 21); }
+};
+
+void gap_registration(benchmark::State& state) {
+  const GapPair pair;
+  const auto threads = static_cast<int>(state.range(0));
+  const auto pool = threads > 1 ? std::make_unique<rgbl::TaskPool>(threads) : nullptr;
+  const rgbl::GapRegistrationOptions options;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(rgbl::register_across_gap(pair.reference, pair.query, rgbl::bench::calibration().T_cam0_lidar,
+                                                       pair.guess, 2.1, options, pool.get()));
+  }
+}
+
 }  // namespace
 
+BENCHMARK(gap_registration)->Name("gap_registration/inline")->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(gap_registration)->Name("gap_registration/pool")->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(scan_registration_rgbl)->Name("scan_registration/rgbl")->Unit(benchmark::kMillisecond);
 BENCHMARK(scan_registration_reference)->Name("scan_registration/reference")->Unit(benchmark::kMillisecond);

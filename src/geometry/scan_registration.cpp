@@ -1,6 +1,7 @@
 #include "rgbl/geometry/scan_registration.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/task_pool.hpp"
 #include "rgbl/geometry/se3.hpp"
 #include "rgbl/geometry/voxel_index.hpp"
 
@@ -8,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <vector>
 
@@ -278,9 +280,22 @@ std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, co
 
 }  // namespace
 
+namespace {
+
+// fn(0) ... fn(n - 1), on the pool when there is one and more than one index
+void for_each_index(TaskPool* pool, std::size_t n, const std::function<void(std::size_t)>& fn) {
+  if (pool != nullptr && n > 1) {
+    pool->parallel_for(n, fn);
+    return;
+  }
+  for (std::size_t k = 0; k < n; ++k) fn(k);
+}
+
+}  // namespace
+
 std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCloudView query,
                                                const Eigen::Isometry3d& T_reference_query_guess,
-                                               const ScanRegistrationOptions& options) {
+                                               const ScanRegistrationOptions& options, TaskPool* pool) {
   options.validate();
   const ScanSample reference_points = voxel_downsample(reference, options, options.reference_voxel);
   const ScanSample query_points = voxel_downsample(query, options, options.query_voxel);
@@ -326,17 +341,21 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
     search.max_iterations = options.search_iterations;
     search.min_correspondences = std::max<std::size_t>(
         6, options.min_correspondences * coarse.points.size() / std::max<std::size_t>(1, query_points.points.size()));
-    std::vector<std::pair<double, Eigen::Isometry3d>> found;  // share of the coarse points landing, pose
-    for (const double along : alongs) {
-      for (const double yaw : yaws) {
-        Eigen::Isometry3d start =
-            T_reference_query_guess *
-            Eigen::Isometry3d(Eigen::AngleAxisd(yaw * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()));
-        start.translation() += along * travel;
-        const auto run = run_icp(grid, coarse, start, search);
-        if (!run) continue;
-        found.emplace_back(landing_share(agreement, coarse, run->T), run->T);
+    // each start's result in its own slot, gathered in the starts' order: the same with any pool
+    std::vector<std::optional<std::pair<double, Eigen::Isometry3d>>> slots(start_count);
+    for_each_index(pool, start_count, [&](std::size_t k) {
+      const double along = alongs[k / yaws.size()], yaw = yaws[k % yaws.size()];
+      Eigen::Isometry3d start =
+          T_reference_query_guess *
+          Eigen::Isometry3d(Eigen::AngleAxisd(yaw * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()));
+      start.translation() += along * travel;
+      if (const auto run = run_icp(grid, coarse, start, search)) {
+        slots[k].emplace(landing_share(agreement, coarse, run->T), run->T);
       }
+    });
+    std::vector<std::pair<double, Eigen::Isometry3d>> found;  // share of the coarse points landing, pose
+    for (const auto& slot : slots) {
+      if (slot) found.push_back(*slot);
     }
     std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
     for (const auto& entry : found) {
@@ -352,12 +371,18 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
     IcpRun run;
     std::size_t landing = 0;  // of `dense`'s points: its agreement
   };
+  std::vector<std::optional<IcpRun>> refined(seeds.size());
+  std::vector<std::size_t> landing(seeds.size(), 0);
+  for_each_index(pool, seeds.size(), [&](std::size_t k) {
+    refined[k] = run_icp(grid, query_points, seeds[k], options);
+    if (refined[k] && refined[k]->converged) landing[k] = agreement.count(dense, refined[k]->T);
+  });
   std::vector<Candidate> converged;
   std::optional<IcpRun> first;  // the first seed's run, reported when nothing converges
-  for (const Eigen::Isometry3d& seed : seeds) {
-    const auto run = run_icp(grid, query_points, seed, options);
+  for (std::size_t k = 0; k < seeds.size(); ++k) {
+    const auto& run = refined[k];
     if (run && !first) first = run;
-    if (run && run->converged) converged.push_back({*run, agreement.count(dense, run->T)});
+    if (run && run->converged) converged.push_back({*run, landing[k]});
   }
   if (converged.empty() && !first) return std::nullopt;
 
@@ -420,7 +445,7 @@ void GapRegistrationOptions::validate() const {
 std::optional<GapRegistration> register_across_gap(PointCloudView reference, PointCloudView query,
                                                    const Eigen::Isometry3d& T_cam_lidar,
                                                    const Eigen::Isometry3d& T_reference_query_guess, double gap_s,
-                                                   const GapRegistrationOptions& options) {
+                                                   const GapRegistrationOptions& options, TaskPool* pool) {
   options.validate();
   GapRegistration g;
   g.allowed_m = options.allowed_m(gap_s);
@@ -430,7 +455,7 @@ std::optional<GapRegistration> register_across_gap(PointCloudView reference, Poi
   search.along_range_m = std::min(g.allowed_m, options.max_along_search_m);
   const Eigen::Isometry3d T_lidar_cam = T_cam_lidar.inverse();
   const Eigen::Isometry3d guess = T_lidar_cam * T_reference_query_guess * T_cam_lidar;
-  std::optional<ScanRegistration> r = register_scans(reference, query, guess, search);
+  std::optional<ScanRegistration> r = register_scans(reference, query, guess, search, pool);
   if (!r) return std::nullopt;
   g.registration = *r;
   // a rotation to 1e-16 again: KITTI's printed extrinsics are one to ~1e-7, and the tracker chains

@@ -302,6 +302,7 @@ RunResult Pipeline::run(const Progress& progress, std::stop_token stop) const {
     // (System::scan_moves): that part is finished here, before the builder is reused. The trajectory
     // is the one of a single thread.
     const auto pool = std::make_shared<TaskPool>(threads_);
+    system->use_task_pool(pool);
     const auto ahead_max = static_cast<std::size_t>(threads_);
     std::vector<FrameBuilder> builders;
     builders.reserve(ahead_max);

@@ -248,6 +248,11 @@ void System::add_place_recognizer(std::unique_ptr<PlaceRecognizer> recognizer) {
   impl_->closer.add_place_recognizer(std::move(recognizer));
 }
 
+void System::use_task_pool(std::shared_ptr<TaskPool> pool) {
+  if (!impl_->records.empty()) throw std::logic_error("System::use_task_pool: only before the first frame");
+  impl_->tracker.use_task_pool(std::move(pool));
+}
+
 void System::finish() {
   if (!impl_->options.threaded_mapping) return;
   impl_->mapping_queue.wait_idle();

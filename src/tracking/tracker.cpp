@@ -164,7 +164,7 @@ void Tracker::register_gap(const Frame& frame, PointCloudView scan, Prediction& 
   prediction.gap = true;
   const auto g = register_across_gap(last_scan_, scan, *T_cam_lidar_,
                                      prediction.T_last_world * prediction.T_cam_world.inverse(), dt,
-                                     options_.gap_registration);
+                                     options_.gap_registration, pool_.get());
   if (!g) {
     logger()->info("frame {}: {:.2f} s after the last frame: too little to register the scans across the gap",
                    frame.index, dt);
@@ -192,7 +192,7 @@ void Tracker::register_lost(const Frame& frame, PointCloudView scan, Prediction&
   const Stopwatch watch;
   const auto g = register_across_gap(last_scan_, scan, *T_cam_lidar_,
                                      prediction.T_last_world * prediction.T_cam_world.inverse(), dt,
-                                     options_.gap_registration);
+                                     options_.gap_registration, pool_.get());
   if (!g) return;
   logger()->debug("frame {}: lost; its scan registers onto the last one {:.2f} m, {:.2f} deg from the "
                   "constant-velocity guess (at most {:.2f} m, {:.2f} deg): runner-up {:.3f} of {:.3f}, probe loss "

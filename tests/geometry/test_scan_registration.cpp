@@ -4,6 +4,7 @@
 #include "rgbl/geometry/point_cloud.hpp"
 #include "rgbl/geometry/scan_agreement.hpp"
 #include "rgbl/geometry/scan_registration.hpp"
+#include "rgbl/core/task_pool.hpp"
 #include "rgbl/geometry/se3.hpp"
 #include "rgbl/io/trajectory_io.hpp"
 #include "support/data.hpp"
@@ -178,6 +179,32 @@ TEST_CASE("registration across a gap: searched and accepted within what the gap 
   rgbl::GapRegistrationOptions bad;
   bad.max_runner_up_ratio = 0.0;
   CHECK_THROWS_AS(rgbl::register_across_gap(reference, query, I, guess, 1.0, bad), rgbl::ConfigError);
+}
+
+TEST_CASE("registration across a gap: the same result on a task pool as inline") {
+  const auto scene = roadside(true);
+  const Eigen::Isometry3d truth = rgbl::make_isometry(rgbl::so3_exp({0.0, 0.0, 0.3}), {22.0, 3.0, 0.0});
+  const auto reference = seen_from(scene, Eigen::Isometry3d::Identity());
+  const auto query = seen_from(scene, truth);
+  const Eigen::Isometry3d guess = rgbl::make_isometry(Eigen::Matrix3d::Identity(), {22.5, 1.2, 0.0});
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+  const auto inline_run = rgbl::register_across_gap(reference, query, I, guess, 1.0, {});
+  REQUIRE(inline_run);
+  REQUIRE(inline_run->registration.starts > 1);  // a search, so there is something to split
+  for (const int threads : {1, 2, 3}) {
+    rgbl::TaskPool pool(threads);
+    const auto pooled = rgbl::register_across_gap(reference, query, I, guess, 1.0, {}, &pool);
+    REQUIRE(pooled);
+    INFO(threads << " threads");
+    // bit for bit: each start is computed alone and gathered in order
+    CHECK(pooled->T_reference_query.matrix() == inline_run->T_reference_query.matrix());
+    CHECK(pooled->registration.converged_starts == inline_run->registration.converged_starts);
+    CHECK(pooled->registration.iterations == inline_run->registration.iterations);
+    CHECK(pooled->registration.agreement == inline_run->registration.agreement);
+    CHECK(pooled->registration.runner_up_agreement == inline_run->registration.runner_up_agreement);
+    CHECK(pooled->registration.min_probe_loss == inline_run->registration.min_probe_loss);
+    CHECK(pooled->accepted == inline_run->accepted);
+  }
 }
 
 TEST_CASE("scan registration: too little to register is no result, bad options are errors") {

@@ -22,6 +22,8 @@
 
 namespace rgbl {
 
+class TaskPool;
+
 struct ScanRegistrationOptions {
   double min_range = 3.0;         // m: nearer returns are the car itself
   double max_range = 60.0;        // m: two scans 30 m apart overlap out here
@@ -86,10 +88,11 @@ struct ScanRegistration {
 // guess T_reference_query (and the heading search's starts). Without a converged start, the guess's
 // own run is returned with converged false. nullopt when there is not enough to register (fewer than
 // min_correspondences correspondences, or a singular system, from every start). Throws ConfigError on
-// bad options.
+// bad options. With a pool, the search's starts and the refined seeds run on it; the result is the
+// same with any pool or none.
 std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCloudView query,
                                                const Eigen::Isometry3d& T_reference_query_guess,
-                                               const ScanRegistrationOptions& options = {});
+                                               const ScanRegistrationOptions& options = {}, TaskPool* pool = nullptr);
 
 // A registration across a gap in the frames: from a constant-velocity guess over gap_s seconds,
 // searched as far as that guess can be off, and taken only as a clear, pinned-down optimum within
@@ -139,6 +142,7 @@ struct GapRegistration {
 std::optional<GapRegistration> register_across_gap(PointCloudView reference, PointCloudView query,
                                                    const Eigen::Isometry3d& T_cam_lidar,
                                                    const Eigen::Isometry3d& T_reference_query_guess, double gap_s,
-                                                   const GapRegistrationOptions& options = {});
+                                                   const GapRegistrationOptions& options = {},
+                                                   TaskPool* pool = nullptr);
 
 }  // namespace rgbl

@@ -105,6 +105,11 @@ class System {
   // Before the first frame: std::logic_error after it.
   void add_place_recognizer(std::unique_ptr<PlaceRecognizer> recognizer);
 
+  // Tracking's work that splits (the scans' registration across a gap in the frames) runs on
+  // `pool`, e.g. the one that builds the frames; the trajectory is the same with any pool or none.
+  // Before the first frame: std::logic_error after it.
+  void use_task_pool(std::shared_ptr<TaskPool> pool);
+
   // Throws what the depth source throws on unusable input (e.g. no right image for the stereo
   // source); a frame without depth (e.g. a dropped LiDAR scan) is tracked on the map alone. With
   // threaded mapping, an exception thrown in the mapping or loop-closing thread (e.g. by a recogniser

@@ -16,11 +16,14 @@
 #include "rgbl/tracking/options.hpp"
 #include "rgbl/tracking/support.hpp"
 
+#include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
 
 namespace rgbl {
+
+class TaskPool;
 
 struct TrackerOutcome {
   TrackState state = TrackState::NotInitialised;
@@ -55,6 +58,10 @@ class Tracker {
 
   // Adds the frame as a keyframe to the map (taking the map lock) and makes it the reference.
   KeyframeId make_keyframe(const Frame& frame);
+
+  // Work that splits runs on `pool` (the scans' registration across a gap in the frames, a few
+  // hundred ms inline); results are the same with any pool or none (nullptr: inline).
+  void use_task_pool(std::shared_ptr<TaskPool> pool) { pool_ = std::move(pool); }
 
   // The map was corrected (a loop closed): the reference keyframe, which was at T_ref_world_before,
   // moved, and the last frames move with it so that the next prediction lands on the corrected map.
@@ -210,6 +217,7 @@ class Tracker {
   PinholeCamera camera_;
   TrackerOptions options_;
   std::optional<Eigen::Isometry3d> T_cam_lidar_;
+  std::shared_ptr<TaskPool> pool_;
   std::vector<LidarPoint> last_scan_;  // the last frame's, when gaps are registered
   TrackState state_ = TrackState::NotInitialised;
   KeyframeId reference_;
