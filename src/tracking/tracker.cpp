@@ -600,9 +600,20 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
     }
     // Lost beyond the recent-loss window and the map does not know this place: carry on in a new map
     // anchored at the lost pose (as ORB-SLAM3's atlas) rather than staying lost until the camera returns.
-    if (was_lost && !first.recent_loss && options_.new_map_when_lost && initialise(frame, prediction.T_cam_world)) {
-      logger()->warn("frame {}: lost since frame {} and relocalisation failed: new map started at the {}", frame.index,
-                     last_ok_frame_, outcome.lost_registered ? "scans' pose" : "constant-velocity guess");
+    // At once where the scans placed the frame and too little of the map is in view from there for an
+    // ok frame (min_ok_inliers; after a gap of seconds the map lies behind the car): waiting for the
+    // motion model cannot bring the frames back onto this map.
+    const int in_view = outcome.lost_registered ? landmarks_in_view(prediction.T_cam_world, reference_) : -1;
+    const bool map_behind = outcome.lost_registered && in_view < options_.min_ok_inliers;
+    if (((was_lost && !first.recent_loss) || map_behind) && options_.new_map_when_lost &&
+        initialise(frame, prediction.T_cam_world)) {
+      if (map_behind && !(was_lost && !first.recent_loss)) {
+        logger()->warn("frame {}: {} of the map's points in view at the scans' pose (an ok frame needs {}): new map "
+                       "started there", frame.index, in_view, options_.min_ok_inliers);
+      } else {
+        logger()->warn("frame {}: lost since frame {} and relocalisation failed: new map started at the {}",
+                       frame.index, last_ok_frame_, outcome.lost_registered ? "scans' pose" : "constant-velocity guess");
+      }
       outcome.new_map = true;
       return;
     }
@@ -986,6 +997,17 @@ std::pair<std::vector<KeyframeId>, KeyframeId> Tracker::local_map_around(const F
     }
   }
   return {std::move(keyframes), sorted.empty() ? reference : sorted.front().second};
+}
+
+int Tracker::landmarks_in_view(const Eigen::Isometry3d& T_cam_world, KeyframeId reference) const {
+  std::shared_lock lock(map_.mutex());
+  const Eigen::Vector3d center = T_cam_world.inverse().translation();
+  int count = 0;
+  for (const LandmarkId id : map_.landmarks_seen_by(local_map_around(Frame{}, reference).first)) {
+    const Landmark* l = map_.landmark(id);
+    if (l != nullptr && view_landmark(*l, T_cam_world, center, camera_, map_.options(), options_.min_view_cos)) ++count;
+  }
+  return count;
 }
 
 Tracker::LocalMapResult Tracker::track_local_map(Frame& frame, KeyframeId reference, std::size_t relocalisation_frame,

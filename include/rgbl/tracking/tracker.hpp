@@ -194,6 +194,8 @@ class Tracker {
                                  ViewLog& views) const;
   // The keyframes sharing points with the frame and their neighbours; the caller holds the map lock.
   std::pair<std::vector<KeyframeId>, KeyframeId> local_map_around(const Frame& frame, KeyframeId reference) const;
+  // Landmarks of the local map around `reference` that a camera at T_cam_world would see.
+  int landmarks_in_view(const Eigen::Isometry3d& T_cam_world, KeyframeId reference) const;
   // The motion-model hypothesis disagrees with the map or with the recent frames (motion_suspect);
   // keypoints: how many the frame has.
   bool suspect(int motion_inliers, const LocalMapResult& local, std::size_t keypoints) const;
