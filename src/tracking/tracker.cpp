@@ -730,46 +730,51 @@ int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t
   for (const auto& [i, p_world] : extra) add(i, p_world);
   if (observations.size() < static_cast<std::size_t>(options_.min_pose_inliers)) return 0;
   PoseOptimizerResult result = optimize_pose(camera_, frame.T_cam_world, observations, options_.pose);
-  if (options_.object_test && result.inliers >= options_.min_pose_inliers) {
-    // the road does not move: its points are no object
-    std::vector<Eigen::Vector3d> measured;
-    std::vector<std::size_t> measured_of;
-    for (std::size_t j = 0; j < observations.size(); ++j) {
-      if (!result.inlier[j] || observations[j].depth <= 0.0) continue;
-      measured.push_back(camera_.unproject(observations[j].pixel, observations[j].depth));
-      measured_of.push_back(j);
-    }
-    const std::vector<bool> on_ground = ground_points(measured, options_);
-    std::vector<bool> road(observations.size(), false);
-    for (std::size_t m = 0; m < on_ground.size(); ++m) road[measured_of[m]] = on_ground[m];
-    const ObjectResiduals objects = objects_against_pose(camera_, result.T_cam_world, observations, result.inlier,
-                                                         road, options_.object_residuals,
-                                                         options_.pose.bounded_depth_error);
-    if (objects.flagged_objects > 0) {
-      std::vector<PoseObservation> kept;
-      std::vector<std::size_t> kept_of;
-      if (frame.moving.empty()) frame.moving.assign(frame.size(), false);
-      for (std::size_t j = 0; j < observations.size(); ++j) {
-        if (objects.flagged[j]) {
-          if (frame.landmarks[keypoint_of[j]].valid()) frame.moved_landmarks.push_back(frame.landmarks[keypoint_of[j]]);
-          frame.moving[keypoint_of[j]] = true;
-          frame.outlier[keypoint_of[j]] = true;
-          continue;
-        }
-        kept.push_back(observations[j]);
-        kept_of.push_back(keypoint_of[j]);
-      }
-      logger()->debug("frame {}: {} of {} objects err together ({} points, overdispersion {:.2f})", frame.index,
-                   objects.flagged_objects, objects.objects, observations.size() - kept.size(),
-                   objects.overdispersion);
-      observations = std::move(kept);
-      keypoint_of = std::move(kept_of);
-      result = optimize_pose(camera_, result.T_cam_world, observations, options_.pose);
-    }
+  if (options_.object_test && result.inliers >= options_.min_pose_inliers &&
+      leave_out_erring_objects(frame, observations, keypoint_of, result.T_cam_world, result.inlier)) {
+    result = optimize_pose(camera_, result.T_cam_world, observations, options_.pose);
   }
   frame.T_cam_world = result.T_cam_world;
   for (std::size_t j = 0; j < observations.size(); ++j) frame.outlier[keypoint_of[j]] = !result.inlier[j];
   return result.inliers;
+}
+
+bool Tracker::leave_out_erring_objects(Frame& frame, std::vector<PoseObservation>& observations,
+                                       std::vector<std::size_t>& keypoint_of, const Eigen::Isometry3d& T_cam_world,
+                                       const std::vector<bool>& inlier) const {
+  // the road does not move: its points are no object
+  std::vector<Eigen::Vector3d> measured;
+  std::vector<std::size_t> measured_of;
+  for (std::size_t j = 0; j < observations.size(); ++j) {
+    if (!inlier[j] || observations[j].depth <= 0.0) continue;
+    measured.push_back(camera_.unproject(observations[j].pixel, observations[j].depth));
+    measured_of.push_back(j);
+  }
+  const std::vector<bool> on_ground = ground_points(measured, options_);
+  std::vector<bool> road(observations.size(), false);
+  for (std::size_t m = 0; m < on_ground.size(); ++m) road[measured_of[m]] = on_ground[m];
+  const ObjectResiduals objects = objects_against_pose(camera_, T_cam_world, observations, inlier, road,
+                                                       options_.object_residuals, options_.pose.bounded_depth_error);
+  if (objects.flagged_objects == 0) return false;
+  std::vector<PoseObservation> kept;
+  std::vector<std::size_t> kept_of;
+  if (frame.moving.empty()) frame.moving.assign(frame.size(), false);
+  for (std::size_t j = 0; j < observations.size(); ++j) {
+    const std::size_t k = keypoint_of[j];
+    if (!objects.flagged[j]) {
+      kept.push_back(observations[j]);
+      kept_of.push_back(k);
+      continue;
+    }
+    if (frame.landmarks[k].valid()) frame.moved_landmarks.push_back(frame.landmarks[k]);
+    frame.moving[k] = true;
+    frame.outlier[k] = true;
+  }
+  logger()->debug("frame {}: {} of {} objects err together ({} points, overdispersion {:.2f})", frame.index,
+                  objects.flagged_objects, objects.objects, observations.size() - kept.size(), objects.overdispersion);
+  observations = std::move(kept);
+  keypoint_of = std::move(kept_of);
+  return true;
 }
 
 int Tracker::track_with_motion_model(Frame& frame, const Frame& reference, const Eigen::Isometry3d& T_guess,

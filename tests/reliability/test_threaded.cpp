@@ -75,7 +75,8 @@ TEST_CASE("threaded mapping: a jump of 20 frames starts a new map while mapping 
   const auto o = rgbl::test::run(*sequence, rgbl::test::jump(0, 14, 35, 44), true);
   INFO(rgbl::test::states(o));
   rgbl::test::check_complete(o);
-  CHECK(o.results[15].state == rgbl::TrackState::Lost);
+  // too little of the map in view where the scans place frame 35: the new map starts there
+  CHECK(o.results[15].new_map);
   int new_maps = 0;
   for (const auto& r : o.results) new_maps += r.new_map ? 1 : 0;
   CHECK(new_maps == 1);

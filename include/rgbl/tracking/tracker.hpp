@@ -206,6 +206,12 @@ class Tracker {
   bool within_reach(const Frame& frame, const Prediction& prediction) const;
   // extra: (keypoint, world point) correspondences that are not landmarks (temporary points).
   int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {}) const;
+  // TrackerOptions::object_test after a pose optimisation (at T_cam_world, with its inliers): removes
+  // the observations of objects that err together, labels their keypoints moving and outliers and
+  // their landmarks moved. True when it removed any (the pose is then optimised again).
+  bool leave_out_erring_objects(Frame& frame, std::vector<PoseObservation>& observations,
+                                std::vector<std::size_t>& keypoint_of, const Eigen::Isometry3d& T_cam_world,
+                                const std::vector<bool>& inlier) const;
   bool need_keyframe(const Frame& frame, int inliers, bool mapping_idle) const;
   std::optional<std::size_t> frames_since_relocalisation(const Frame& frame) const {
     return frames_since(frame, last_relocalisation_frame_);
