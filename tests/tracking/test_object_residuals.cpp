@@ -3,6 +3,7 @@
 #include "rgbl/tracking/object_residuals.hpp"
 
 #include "rgbl/core/error.hpp"
+#include "support/kitti_camera.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -10,15 +11,7 @@
 
 namespace {
 
-rgbl::PinholeCamera camera() {
-  rgbl::PinholeCamera c;
-  c.fx = c.fy = 500.0;
-  c.cx = 400.0;
-  c.cy = 150.0;
-  c.width = 800;
-  c.height = 300;
-  return c;
-}
+rgbl::PinholeCamera camera() { return rgbl::test::kitti_camera(); }
 
 struct Scene {
   std::vector<rgbl::PoseObservation> observations;
