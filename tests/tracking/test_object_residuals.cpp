@@ -11,18 +11,18 @@
 
 namespace {
 
-rgbl::PinholeCamera camera() { return rgbl::test::kitti_camera(); }
+rgbl::PinholeCamera object_camera() { return rgbl::test::kitti_camera(); }
 
-struct Scene {
+struct ObjectScene {
   std::vector<rgbl::PoseObservation> observations;
   std::vector<int> object;  // per observation: which object made it (-1 none)
 };
 
 // count points on a patch around pixel (u, v) at depth z (a fronto-parallel surface), measured with
 // the given pixel and depth noise; the landmark is the true point moved by `moved` (camera frame).
-void add_object(Scene& scene, std::mt19937& rng, int id, double u, double v, double z, int count,
+void add_object(ObjectScene& scene, std::mt19937& rng, int id, double u, double v, double z, int count,
                 const Eigen::Vector3d& moved = Eigen::Vector3d::Zero()) {
-  const rgbl::PinholeCamera c = camera();
+  const rgbl::PinholeCamera c = object_camera();
   std::uniform_real_distribution<double> offset(-15.0, 15.0);
   std::normal_distribution<double> unit(0.0, 1.0);
   for (int k = 0; k < count; ++k) {
@@ -48,7 +48,7 @@ TEST_CASE("object residuals: a car that moved with the camera is flagged, static
   int false_flags = 0, car_found = 0;
   for (unsigned seed = 1; seed <= 50; ++seed) {
     std::mt19937 rng(seed);
-    Scene scene;
+    ObjectScene scene;
     add_object(scene, rng, 0, 100.0, 150.0, 12.0, 25);
     add_object(scene, rng, 1, 250.0, 120.0, 25.0, 25);
     add_object(scene, rng, 2, 550.0, 130.0, 18.0, 25);
@@ -57,7 +57,7 @@ TEST_CASE("object residuals: a car that moved with the camera is flagged, static
     // camera); one sigma of its depth is 0.3 m, so every point passes the per-point tests
     add_object(scene, rng, 4, 400.0, 140.0, 30.0, 20, Eigen::Vector3d(0.0, 0.0, -0.6));
     const std::vector<bool> inlier(scene.observations.size(), true);
-    const auto result = rgbl::objects_against_pose(camera(), T, scene.observations, inlier, {}, options, false);
+    const auto result = rgbl::objects_against_pose(object_camera(), T, scene.observations, inlier, {}, options, false);
     CHECK(result.objects == 5);
     bool car = true;
     for (std::size_t j = 0; j < scene.observations.size(); ++j) {
@@ -74,14 +74,14 @@ TEST_CASE("object residuals: the pose stands on the rest, and excluded and outli
           "[tracking][objects]") {
   const rgbl::ObjectResidualOptions options;
   std::mt19937 rng(7);
-  Scene scene;
+  ObjectScene scene;
   add_object(scene, rng, 0, 100.0, 150.0, 12.0, 10);
   add_object(scene, rng, 1, 250.0, 120.0, 25.0, 10);
   add_object(scene, rng, 2, 550.0, 130.0, 18.0, 10);
   add_object(scene, rng, 4, 400.0, 140.0, 30.0, 20, Eigen::Vector3d(0.0, 0.0, -0.6));  // 40 % of the points
   const std::vector<bool> inlier(scene.observations.size(), true);
   const Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  auto result = rgbl::objects_against_pose(camera(), T, scene.observations, inlier, {}, options, false);
+  auto result = rgbl::objects_against_pose(object_camera(), T, scene.observations, inlier, {}, options, false);
   CHECK(result.objects == 4);
   CHECK(result.flagged_objects == 0);  // over max_share: not a minority to leave out
 
@@ -91,7 +91,7 @@ TEST_CASE("object residuals: the pose stands on the rest, and excluded and outli
   for (std::size_t j = 30; j < 35; ++j) some_inliers[j] = false;
   rgbl::ObjectResidualOptions larger = options;
   larger.max_share = 0.5;
-  result = rgbl::objects_against_pose(camera(), T, scene.observations, some_inliers, exclude, larger, false);
+  result = rgbl::objects_against_pose(object_camera(), T, scene.observations, some_inliers, exclude, larger, false);
   CHECK(result.objects == 3);
   CHECK(result.flagged_objects == 1);
   for (std::size_t j = 0; j < scene.observations.size(); ++j)
@@ -100,7 +100,7 @@ TEST_CASE("object residuals: the pose stands on the rest, and excluded and outli
   // fewer objects than min_objects: nothing to measure the overdispersion by
   rgbl::ObjectResidualOptions strict = larger;
   strict.min_objects = 4;
-  CHECK(rgbl::objects_against_pose(camera(), T, scene.observations, some_inliers, exclude, strict, false).flagged_objects == 0);
+  CHECK(rgbl::objects_against_pose(object_camera(), T, scene.observations, some_inliers, exclude, strict, false).flagged_objects == 0);
 
   rgbl::ObjectResidualOptions bad;
   bad.max_share = 1.0;
