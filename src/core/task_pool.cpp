@@ -108,4 +108,12 @@ void TaskPool::parallel_for(std::size_t n, const std::function<void(std::size_t)
   if (first) std::rethrow_exception(first);
 }
 
+void parallel_for(TaskPool* pool, std::size_t n, const std::function<void(std::size_t)>& fn) {
+  if (pool != nullptr) {
+    pool->parallel_for(n, fn);
+    return;
+  }
+  for (std::size_t i = 0; i < n; ++i) fn(i);
+}
+
 }  // namespace rgbl

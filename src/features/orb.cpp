@@ -524,11 +524,7 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<Keypoint>& keypoints
   build_pyramid(gray);
   const auto levels = static_cast<std::size_t>(options_.num_levels);
   const auto each_level = [&](auto&& fn) {
-    if (pool != nullptr) {  // runs them in order itself when the pool has one thread
-      pool->parallel_for(levels, [&](std::size_t l) { fn(static_cast<int>(l)); });
-    } else {
-      for (std::size_t l = 0; l < levels; ++l) fn(static_cast<int>(l));
-    }
+    parallel_for(pool, levels, [&](std::size_t l) { fn(static_cast<int>(l)); });
   };
   each_level([this](int l) { detect_level(l); });
   // A level keeps exactly its budget when it has at least that many candidates; only a level that

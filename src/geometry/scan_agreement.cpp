@@ -1,11 +1,11 @@
 #include "rgbl/geometry/scan_agreement.hpp"
 
+#include "rgbl/core/disjoint_sets.hpp"
 #include "rgbl/core/error.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <numeric>
 
 namespace rgbl {
 
@@ -131,21 +131,15 @@ std::vector<std::uint32_t> label_objects(const ScanSample& sample, double edge) 
     if (added) keys.push_back(key);
     slot_of[i] = slot;
   }
-  // union-find over the voxels, each joined with its 26 neighbours
-  std::vector<std::uint32_t> parent(keys.size());
-  std::iota(parent.begin(), parent.end(), 0U);
-  const auto root = [&](std::uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
+  // the voxels, each joined with its 26 neighbours
+  DisjointSets groups(keys.size());
   for (std::uint32_t s = 0; s < keys.size(); ++s) {
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dz = -1; dz <= 1; ++dz) {
           const std::uint32_t t = index.find({keys[s].x + dx, keys[s].y + dy, keys[s].z + dz});
           if (t == VoxelIndex::npos || t <= s) continue;  // each pair once
-          const std::uint32_t rs = root(s), rt = root(t);
-          if (rs != rt) parent[std::max(rs, rt)] = std::min(rs, rt);
+          groups.join(s, t);
         }
       }
     }
@@ -155,7 +149,7 @@ std::vector<std::uint32_t> label_objects(const ScanSample& sample, double edge) 
   std::vector<std::uint32_t> labels(sample.points.size());
   std::uint32_t next = 0;
   for (std::size_t i = 0; i < sample.points.size(); ++i) {
-    std::uint32_t& label = label_of_root[root(slot_of[i])];
+    std::uint32_t& label = label_of_root[groups.root(slot_of[i])];
     if (label == VoxelIndex::npos) label = next++;
     labels[i] = label;
   }

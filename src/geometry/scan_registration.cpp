@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <numbers>
 #include <vector>
 
@@ -280,19 +279,6 @@ std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, co
 
 }  // namespace
 
-namespace {
-
-// fn(0) ... fn(n - 1), on the pool when there is one and more than one index
-void for_each_index(TaskPool* pool, std::size_t n, const std::function<void(std::size_t)>& fn) {
-  if (pool != nullptr && n > 1) {
-    pool->parallel_for(n, fn);
-    return;
-  }
-  for (std::size_t k = 0; k < n; ++k) fn(k);
-}
-
-}  // namespace
-
 std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCloudView query,
                                                const Eigen::Isometry3d& T_reference_query_guess,
                                                const ScanRegistrationOptions& options, TaskPool* pool) {
@@ -343,7 +329,7 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
         6, options.min_correspondences * coarse.points.size() / std::max<std::size_t>(1, query_points.points.size()));
     // each start's result in its own slot, gathered in the starts' order: the same with any pool
     std::vector<std::optional<std::pair<double, Eigen::Isometry3d>>> slots(start_count);
-    for_each_index(pool, start_count, [&](std::size_t k) {
+    parallel_for(pool, start_count, [&](std::size_t k) {
       const double along = alongs[k / yaws.size()], yaw = yaws[k % yaws.size()];
       Eigen::Isometry3d start =
           T_reference_query_guess *
@@ -373,7 +359,7 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
   };
   std::vector<std::optional<IcpRun>> refined(seeds.size());
   std::vector<std::size_t> landing(seeds.size(), 0);
-  for_each_index(pool, seeds.size(), [&](std::size_t k) {
+  parallel_for(pool, seeds.size(), [&](std::size_t k) {
     refined[k] = run_icp(grid, query_points, seeds[k], options);
     if (refined[k] && refined[k]->converged) landing[k] = agreement.count(dense, refined[k]->T);
   });

@@ -1,18 +1,15 @@
 #include "rgbl/tracking/object_residuals.hpp"
 
+#include "rgbl/core/disjoint_sets.hpp"
 #include "rgbl/core/error.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
+#include <cstdint>
 
 namespace rgbl {
 
 void ObjectResidualOptions::validate() const {
-  require(std::isfinite(radius_px) && radius_px > 0.0, "tracker.object_test.radius_px", "> 0 px");
-  require(std::isfinite(min_tolerance) && min_tolerance >= 0.0, "tracker.object_test.min_tolerance", ">= 0 m");
-  require(std::isfinite(relative_tolerance) && relative_tolerance >= 0.0, "tracker.object_test.relative_tolerance",
-          ">= 0");
   require(min_points >= 2, "tracker.object_test.min_points", ">= 2");
   require(std::isfinite(chi2) && chi2 > 0.0, "tracker.object_test.chi2", "> 0");
   require(min_objects >= 1, "tracker.object_test.min_objects", ">= 1");
@@ -20,27 +17,10 @@ void ObjectResidualOptions::validate() const {
           "in (0, 1)");
 }
 
-namespace {
-
-struct UnionFind {
-  std::vector<int> parent;
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int a) {
-    while (parent[static_cast<std::size_t>(a)] != a) {
-      parent[static_cast<std::size_t>(a)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(a)])];
-      a = parent[static_cast<std::size_t>(a)];
-    }
-    return a;
-  }
-  void join(int a, int b) { parent[static_cast<std::size_t>(find(a))] = find(b); }
-};
-
-}  // namespace
-
 ObjectResiduals objects_against_pose(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world,
                                      std::span<const PoseObservation> observations, const std::vector<bool>& inlier,
-                                     const std::vector<bool>& exclude, const ObjectResidualOptions& options,
-                                     bool bounded_depth_error) {
+                                     const std::vector<bool>& exclude, const ObjectGrouping& grouping,
+                                     const ObjectResidualOptions& options, bool bounded_depth_error) {
   ObjectResiduals out;
   out.flagged.assign(observations.size(), false);
   // the tested observations and their whitened residuals
@@ -59,19 +39,19 @@ ObjectResiduals objects_against_pose(const PinholeCamera& camera, const Eigen::I
   const std::size_t n = tested.size();
   if (n < static_cast<std::size_t>(options.min_points)) return out;
   // depth-continuous neighbours in the image: one rigid surface
-  UnionFind groups(n);
-  const double r2 = options.radius_px * options.radius_px;
+  DisjointSets groups(n);
+  const double r2 = grouping.radius_px * grouping.radius_px;
   for (std::size_t a = 0; a < n; ++a) {
     const PoseObservation& oa = observations[tested[a]];
-    const double tolerance = std::max(options.min_tolerance, options.relative_tolerance * oa.depth);
+    const double tolerance = std::max(grouping.min_tolerance, grouping.relative_tolerance * oa.depth);
     for (std::size_t b = a + 1; b < n; ++b) {
       const PoseObservation& ob = observations[tested[b]];
       if ((oa.pixel - ob.pixel).squaredNorm() > r2 || std::abs(oa.depth - ob.depth) > tolerance) continue;
-      groups.join(static_cast<int>(a), static_cast<int>(b));
+      groups.join(static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b));
     }
   }
   std::vector<std::vector<std::size_t>> members(n);
-  for (std::size_t a = 0; a < n; ++a) members[static_cast<std::size_t>(groups.find(static_cast<int>(a)))].push_back(a);
+  for (std::size_t a = 0; a < n; ++a) members[groups.root(static_cast<std::uint32_t>(a))].push_back(a);
   struct Object {
     double statistic;
     std::size_t root;
@@ -98,7 +78,7 @@ ObjectResiduals objects_against_pose(const PinholeCamera& camera, const Eigen::I
   for (const Object& o : objects) {
     if (o.statistic <= options.chi2 * out.overdispersion) break;
     const auto& m = members[o.root];
-    if (static_cast<double>(m.size()) >= limit || static_cast<double>(taken + m.size()) >= limit) continue;
+    if (static_cast<double>(taken + m.size()) >= limit) continue;  // each, and all of them together
     taken += m.size();
     ++out.flagged_objects;
     for (const std::size_t a : m) out.flagged[tested[a]] = true;

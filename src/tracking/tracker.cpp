@@ -603,11 +603,13 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
     // At once where the scans placed the frame and too little of the map is in view from there for an
     // ok frame (min_ok_inliers; after a gap of seconds the map lies behind the car): waiting for the
     // motion model cannot bring the frames back onto this map.
-    const int in_view = outcome.lost_registered ? landmarks_in_view(prediction.T_cam_world, reference_) : -1;
-    const bool map_behind = outcome.lost_registered && in_view < options_.min_ok_inliers;
-    if (((was_lost && !first.recent_loss) || map_behind) && options_.new_map_when_lost &&
-        initialise(frame, prediction.T_cam_world)) {
-      if (map_behind && !(was_lost && !first.recent_loss)) {
+    const bool window_over = was_lost && !first.recent_loss;
+    const int in_view = options_.new_map_when_lost && !window_over && outcome.lost_registered
+                            ? landmarks_in_view(prediction.T_cam_world, reference_)
+                            : -1;
+    const bool map_behind = in_view >= 0 && in_view < options_.min_ok_inliers;
+    if ((window_over || map_behind) && options_.new_map_when_lost && initialise(frame, prediction.T_cam_world)) {
+      if (map_behind) {
         logger()->warn("frame {}: {} of the map's points in view at the scans' pose (an ok frame needs {}): new map "
                        "started there", frame.index, in_view, options_.min_ok_inliers);
       } else {
@@ -753,7 +755,9 @@ bool Tracker::leave_out_erring_objects(Frame& frame, std::vector<PoseObservation
   const std::vector<bool> on_ground = ground_points(measured, options_);
   std::vector<bool> road(observations.size(), false);
   for (std::size_t m = 0; m < on_ground.size(); ++m) road[measured_of[m]] = on_ground[m];
-  const ObjectResiduals objects = objects_against_pose(camera_, T_cam_world, observations, inlier, road,
+  const ObjectGrouping grouping{options_.moving_label_radius, options_.ransac_min_tolerance,
+                                options_.ransac_relative_tolerance};
+  const ObjectResiduals objects = objects_against_pose(camera_, T_cam_world, observations, inlier, road, grouping,
                                                        options_.object_residuals, options_.pose.bounded_depth_error);
   if (objects.flagged_objects == 0) return false;
   std::vector<PoseObservation> kept;

@@ -1,10 +1,10 @@
 #include "bench/reference/scan_registration_reference.hpp"
 #include "rgbl/core/error.hpp"
+#include "rgbl/core/task_pool.hpp"
 #include "rgbl/geometry/calibration.hpp"
 #include "rgbl/geometry/point_cloud.hpp"
 #include "rgbl/geometry/scan_agreement.hpp"
 #include "rgbl/geometry/scan_registration.hpp"
-#include "rgbl/core/task_pool.hpp"
 #include "rgbl/geometry/se3.hpp"
 #include "rgbl/io/trajectory_io.hpp"
 #include "support/data.hpp"
@@ -72,6 +72,19 @@ std::vector<rgbl::LidarPoint> seen_from(const std::vector<rgbl::LidarPoint>& sce
 
 double deg(const Eigen::Matrix3d& R) { return rgbl::rotation_angle(R) * 180.0 / std::numbers::pi; }
 
+// The roadside at a bend: the query 22 m on and turned 17 deg, and the guess of a motion model that
+// kept going straight into the bend (17 deg short, 2 m off).
+struct Bend {
+  Eigen::Isometry3d truth = rgbl::make_isometry(rgbl::so3_exp({0.0, 0.0, 0.3}), {22.0, 3.0, 0.0});
+  Eigen::Isometry3d guess = rgbl::make_isometry(Eigen::Matrix3d::Identity(), {22.5, 1.2, 0.0});
+  std::vector<rgbl::LidarPoint> reference, query;
+  Bend() {
+    const auto scene = roadside(true);
+    reference = seen_from(scene, Eigen::Isometry3d::Identity());
+    query = seen_from(scene, truth);
+  }
+};
+
 }  // namespace
 
 TEST_CASE("scan registration: trunks and houses pin the pose down from a guess 1.5 m off") {
@@ -108,12 +121,9 @@ TEST_CASE("scan registration: a corridor leaves the along-track position open, a
 }
 
 TEST_CASE("scan registration: a guess turned 15 deg too far is found again by the heading search") {
-  const auto scene = roadside(true);
-  const Eigen::Isometry3d truth = rgbl::make_isometry(rgbl::so3_exp({0.0, 0.0, 0.3}), {22.0, 3.0, 0.0});
-  const auto reference = seen_from(scene, Eigen::Isometry3d::Identity());
-  const auto query = seen_from(scene, truth);
-  // the guess of a motion model that kept going straight into a bend: 17 deg short, 2 m off
-  const Eigen::Isometry3d guess = rgbl::make_isometry(Eigen::Matrix3d::Identity(), {22.5, 1.2, 0.0});
+  const Bend bend;
+  const Eigen::Isometry3d &truth = bend.truth, &guess = bend.guess;
+  const std::vector<rgbl::LidarPoint> &reference = bend.reference, &query = bend.query;
   rgbl::ScanRegistrationOptions o;
   const auto single = rgbl::register_scans(reference, query, guess, o);
   const auto error_of = [&](const rgbl::ScanRegistration& r) { return truth.inverse() * r.T_reference_query; };
@@ -136,11 +146,9 @@ TEST_CASE("scan registration: a guess turned 15 deg too far is found again by th
 }
 
 TEST_CASE("registration across a gap: searched and accepted within what the gap allows, refused beyond or on a ridge") {
-  const auto scene = roadside(true);
-  const Eigen::Isometry3d truth = rgbl::make_isometry(rgbl::so3_exp({0.0, 0.0, 0.3}), {22.0, 3.0, 0.0});
-  const auto reference = seen_from(scene, Eigen::Isometry3d::Identity());
-  const auto query = seen_from(scene, truth);
-  const Eigen::Isometry3d guess = rgbl::make_isometry(Eigen::Matrix3d::Identity(), {22.5, 1.2, 0.0});
+  const Bend bend;
+  const Eigen::Isometry3d &truth = bend.truth, &guess = bend.guess;
+  const std::vector<rgbl::LidarPoint> &reference = bend.reference, &query = bend.query;
   const rgbl::GapRegistrationOptions o;
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();  // the scans' frames are the "camera" frames
   // 1 s: 2 + 25 deg and 1 + 2 m allowed; the 17 deg and 1.9 m the guess is off are within, and searched
@@ -182,11 +190,9 @@ TEST_CASE("registration across a gap: searched and accepted within what the gap 
 }
 
 TEST_CASE("registration across a gap: the same result on a task pool as inline") {
-  const auto scene = roadside(true);
-  const Eigen::Isometry3d truth = rgbl::make_isometry(rgbl::so3_exp({0.0, 0.0, 0.3}), {22.0, 3.0, 0.0});
-  const auto reference = seen_from(scene, Eigen::Isometry3d::Identity());
-  const auto query = seen_from(scene, truth);
-  const Eigen::Isometry3d guess = rgbl::make_isometry(Eigen::Matrix3d::Identity(), {22.5, 1.2, 0.0});
+  const Bend bend;
+  const Eigen::Isometry3d& guess = bend.guess;
+  const std::vector<rgbl::LidarPoint> &reference = bend.reference, &query = bend.query;
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
   const auto inline_run = rgbl::register_across_gap(reference, query, I, guess, 1.0, {});
   REQUIRE(inline_run);

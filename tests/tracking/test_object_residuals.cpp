@@ -1,6 +1,7 @@
 // Objects whose residuals err together (rgbl/tracking/object_residuals.hpp): static objects with
 // independent noise and a car whose landmarks lie where it was a few frames ago, at an exactly known pose.
 #include "rgbl/tracking/object_residuals.hpp"
+#include "rgbl/tracking/options.hpp"
 
 #include "rgbl/core/error.hpp"
 #include "support/kitti_camera.hpp"
@@ -12,6 +13,12 @@
 namespace {
 
 rgbl::PinholeCamera object_camera() { return rgbl::test::kitti_camera(); }
+
+// grouped as the tracker groups them
+rgbl::ObjectGrouping tracker_grouping() {
+  const rgbl::TrackerOptions t;
+  return {t.moving_label_radius, t.ransac_min_tolerance, t.ransac_relative_tolerance};
+}
 
 struct ObjectScene {
   std::vector<rgbl::PoseObservation> observations;
@@ -57,7 +64,8 @@ TEST_CASE("object residuals: a car that moved with the camera is flagged, static
     // camera); one sigma of its depth is 0.3 m, so every point passes the per-point tests
     add_object(scene, rng, 4, 400.0, 140.0, 30.0, 20, Eigen::Vector3d(0.0, 0.0, -0.6));
     const std::vector<bool> inlier(scene.observations.size(), true);
-    const auto result = rgbl::objects_against_pose(object_camera(), T, scene.observations, inlier, {}, options, false);
+    const auto result =
+        rgbl::objects_against_pose(object_camera(), T, scene.observations, inlier, {}, tracker_grouping(), options, false);
     CHECK(result.objects == 5);
     bool car = true;
     for (std::size_t j = 0; j < scene.observations.size(); ++j) {
@@ -81,7 +89,8 @@ TEST_CASE("object residuals: the pose stands on the rest, and excluded and outli
   add_object(scene, rng, 4, 400.0, 140.0, 30.0, 20, Eigen::Vector3d(0.0, 0.0, -0.6));  // 40 % of the points
   const std::vector<bool> inlier(scene.observations.size(), true);
   const Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  auto result = rgbl::objects_against_pose(object_camera(), T, scene.observations, inlier, {}, options, false);
+  auto result =
+      rgbl::objects_against_pose(object_camera(), T, scene.observations, inlier, {}, tracker_grouping(), options, false);
   CHECK(result.objects == 4);
   CHECK(result.flagged_objects == 0);  // over max_share: not a minority to leave out
 
@@ -91,7 +100,8 @@ TEST_CASE("object residuals: the pose stands on the rest, and excluded and outli
   for (std::size_t j = 30; j < 35; ++j) some_inliers[j] = false;
   rgbl::ObjectResidualOptions larger = options;
   larger.max_share = 0.5;
-  result = rgbl::objects_against_pose(object_camera(), T, scene.observations, some_inliers, exclude, larger, false);
+  result = rgbl::objects_against_pose(object_camera(), T, scene.observations, some_inliers, exclude, tracker_grouping(),
+                                      larger, false);
   CHECK(result.objects == 3);
   CHECK(result.flagged_objects == 1);
   for (std::size_t j = 0; j < scene.observations.size(); ++j)
@@ -100,7 +110,9 @@ TEST_CASE("object residuals: the pose stands on the rest, and excluded and outli
   // fewer objects than min_objects: nothing to measure the overdispersion by
   rgbl::ObjectResidualOptions strict = larger;
   strict.min_objects = 4;
-  CHECK(rgbl::objects_against_pose(object_camera(), T, scene.observations, some_inliers, exclude, strict, false).flagged_objects == 0);
+  CHECK(rgbl::objects_against_pose(object_camera(), T, scene.observations, some_inliers, exclude, tracker_grouping(),
+                                   strict, false)
+            .flagged_objects == 0);
 
   rgbl::ObjectResidualOptions bad;
   bad.max_share = 1.0;

@@ -87,4 +87,8 @@ class TaskPool {
   std::vector<std::thread> workers_;
 };
 
+// fn(0) ... fn(n - 1) on `pool`, or in order on the calling thread without one (nullptr): for callers
+// whose pool is optional.
+void parallel_for(TaskPool* pool, std::size_t n, const std::function<void(std::size_t)>& fn);
+
 }  // namespace rgbl

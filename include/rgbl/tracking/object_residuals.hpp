@@ -16,12 +16,16 @@
 
 namespace rgbl {
 
+// Two observations with depth are on one object when their pixels are within radius_px and their
+// depths within max(min_tolerance, relative_tolerance * depth). The tracker passes the ones its moving
+// labels group keypoints by (TrackerOptions::moving_label_radius, the RANSAC's tolerances).
+struct ObjectGrouping {
+  double radius_px = 0.0;
+  double min_tolerance = 0.0;  // m
+  double relative_tolerance = 0.0;
+};
+
 struct ObjectResidualOptions {
-  // Two observations with depth are on one object when their pixels are within radius_px and their
-  // depths within max(min_tolerance, relative_tolerance * depth) (the tracker's RANSAC tolerances).
-  double radius_px = 24.0;
-  double min_tolerance = 0.2;      // m
-  double relative_tolerance = 0.03;
   int min_points = 5;              // smaller groups are left to the per-point tests
   // An object errs together when n |mean whitened residual|^2 (chi2 with 3 dof for independent unit
   // noise) exceeds chi2 times the frame's own overdispersion: the median of that statistic over the
@@ -50,7 +54,7 @@ struct ObjectResiduals {
 // allows.
 ObjectResiduals objects_against_pose(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world,
                                      std::span<const PoseObservation> observations, const std::vector<bool>& inlier,
-                                     const std::vector<bool>& exclude, const ObjectResidualOptions& options,
-                                     bool bounded_depth_error);
+                                     const std::vector<bool>& exclude, const ObjectGrouping& grouping,
+                                     const ObjectResidualOptions& options, bool bounded_depth_error);
 
 }  // namespace rgbl

@@ -103,7 +103,8 @@ struct TrackerOptions {
   // After each pose optimisation, objects (depth-continuous groups of inliers off the road) whose
   // residuals err together are left out and the pose optimised again (object_residuals.hpp): a car
   // ahead at about the ego speed stays inside every per-point gate. Their keypoints are labelled
-  // moving. Its grouping's defaults are moving_label_radius and the RANSAC's tolerances.
+  // moving. Objects are grouped as the moving labels are: within moving_label_radius px, at depths
+  // within the RANSAC's tolerance.
   bool object_test = false;
   ObjectResidualOptions object_residuals;
   double ground_min_height = 0.8;          // m below the camera
