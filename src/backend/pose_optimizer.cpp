@@ -82,7 +82,7 @@ PoseOptimizerResult optimize_pose(const PinholeCamera& camera, const Eigen::Isom
         double weight = 1.0;
         if (robust) {
           const double delta2 = dim == 3 ? options.chi2_3d : options.chi2_2d;
-          if (options.cauchy) {
+          if (options.cauchy && round > 0) {
             weight = 1.0 / (1.0 + e2 / delta2);
           } else if (e2 > delta2) {
             weight = std::sqrt(delta2 / e2);
@@ -96,7 +96,10 @@ PoseOptimizerResult optimize_pose(const PinholeCamera& camera, const Eigen::Isom
       const Vector6d dx = H.ldlt().solve(-g);
       if (!dx.allFinite()) break;
       result.T_cam_world = se3_exp(dx) * result.T_cam_world;
-      if (dx.squaredNorm() < 1e-16) break;
+      // Converged at |dx| < 1e-5 (10 um, 10 urad), far below what the data resolve. Cauchy's weights
+      // change with every step, so it approaches a stricter bound slowly: on 04 at 1e-8 it took 2697
+      // steps against Huber's 1646, at 1e-5 1563, with the trajectory the same to 1e-6 m.
+      if (dx.squaredNorm() < 1e-10) break;
     }
     // Re-classify every observation (outliers may come back) by its chi2 at the current pose.
     result.inliers = 0;

@@ -418,6 +418,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
   if (s.reference_landmark_ratio && !(*s.reference_landmark_ratio >= 0.0 && *s.reference_landmark_ratio <= 1.0))
     r.fail("Tracking.ReferenceLandmarkRatio", "a share from 0 (off) to 1");
   s.bounded_depth_error = flag("Tracking.BoundedDepthError");
+  s.cauchy_weights = flag("Tracking.CauchyWeights");
   s.object_test = flag("Tracking.ObjectTest");
   s.register_gaps = flag("Tracking.RegisterGaps");
   s.register_lost = flag("Tracking.RegisterLost");

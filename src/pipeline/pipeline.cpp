@@ -94,6 +94,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.lidar_pair_agreeing_sigma) p.system.mapping.pairs.lidar_agreeing_sigma_translation = *s.lidar_pair_agreeing_sigma;
   if (s.reference_landmark_ratio) p.system.tracker.reference_landmark_ratio = *s.reference_landmark_ratio;
   if (s.bounded_depth_error) p.system.tracker.pose.bounded_depth_error = *s.bounded_depth_error;
+  if (s.cauchy_weights) p.system.tracker.pose.cauchy = *s.cauchy_weights;
   if (s.object_test) p.system.tracker.object_test = *s.object_test;
   if (s.register_gaps) p.system.tracker.register_gaps = *s.register_gaps;
   if (s.register_lost) p.system.tracker.register_lost = *s.register_lost;

@@ -226,3 +226,81 @@ TEST_CASE("depth noise model: a registration error weighs where the depth change
   m.registration_sigma_deg = -0.1;
   CHECK_THROWS_AS(m.validate(), rgbl::ConfigError);
 }
+
+TEST_CASE("pose optimisation: cauchy weights after a huber round keep fewer of the matches that err together") {
+  // 45 % of the matches 7-13 px off the same way (a repeated pattern matched one period off, a vehicle
+  // crossing): Huber's constant influence pulls the pose towards them and the outlier rounds then keep
+  // some, at the static points' cost. Fixed seeds, so the figures are exact: over 20 scenes
+  // huber misclassifies 175 matches and is 14.4 mm off on average, cauchy 152 and 11.1 mm.
+  const auto cam = rgbl::test::kitti_camera();
+  const Eigen::Isometry3d T_true = test_pose();
+  rgbl::PoseOptimizerOptions huber, cauchy;
+  cauchy.cauchy = true;
+  double error_huber = 0.0, error_cauchy = 0.0;
+  int wrong_huber = 0, wrong_cauchy = 0;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    std::mt19937 rng(seed);
+    const auto points = scene(rng, T_true, 200);
+    std::normal_distribution<double> px_noise(0.0, 1.0), unit(0.0, 1.0);
+    std::uniform_real_distribution<double> share(0.0, 1.0), spread(-3.0, 3.0);
+    std::vector<rgbl::PoseObservation> obs;
+    std::vector<bool> off;
+    for (const auto& p : points) {
+      const Eigen::Vector3d pc = T_true * p;
+      rgbl::PoseObservation o;
+      o.p_world = p;
+      o.pixel = cam.project_unchecked(pc) + Eigen::Vector2d(px_noise(rng), px_noise(rng));
+      o.depth_sigma = 0.01 * pc.z();
+      o.depth = pc.z() + o.depth_sigma * unit(rng);
+      off.push_back(share(rng) < 0.45);
+      if (off.back()) o.pixel += Eigen::Vector2d(10.0 + spread(rng), spread(rng));
+      obs.push_back(o);
+    }
+    rgbl::Vector6d start;
+    start << 0.03, -0.03, 0.3, 0.006, 0.003, -0.003;  // a motion model's guess
+    const auto solve = [&](const rgbl::PoseOptimizerOptions& options, int& wrong) {
+      const auto r = rgbl::optimize_pose(cam, rgbl::se3_exp(start) * T_true, obs, options);
+      for (std::size_t i = 0; i < obs.size(); ++i) wrong += off[i] == r.inlier[i] ? 1 : 0;
+      return (r.T_cam_world * T_true.inverse()).translation().norm();
+    };
+    error_huber += solve(huber, wrong_huber) / 20.0;
+    error_cauchy += solve(cauchy, wrong_cauchy) / 20.0;
+  }
+  INFO("huber " << error_huber << " m, " << wrong_huber << " misclassified; cauchy " << error_cauchy << " m, "
+                << wrong_cauchy);
+  CHECK(error_cauchy < 0.85 * error_huber);
+  CHECK(wrong_cauchy < 0.9 * wrong_huber);
+  CHECK(error_cauchy < 0.012);
+}
+
+TEST_CASE("pose optimisation: cauchy weights after a huber round find a pose 1.3 m off as huber does") {
+  // The first round is Huber's so that a start far off (a gap, a relocalisation) still reaches the pose.
+  const auto cam = rgbl::test::kitti_camera();
+  const Eigen::Isometry3d T_true = test_pose();
+  std::mt19937 rng(5);
+  const auto points = scene(rng, T_true, 300);
+  std::normal_distribution<double> px_noise(0.0, 1.0), z_noise(0.0, 0.05);
+  std::uniform_real_distribution<double> wild(-60.0, 60.0);
+  std::vector<rgbl::PoseObservation> obs;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    rgbl::PoseObservation o;
+    o.p_world = points[i];
+    const Eigen::Vector3d pc = T_true * points[i];
+    o.pixel = cam.project_unchecked(pc) + Eigen::Vector2d(px_noise(rng), px_noise(rng));
+    if (i % 2 == 0) {
+      o.depth = pc.z() + z_noise(rng);
+      o.depth_sigma = 0.05;
+    }
+    if (i % 4 == 0) o.pixel += Eigen::Vector2d(wild(rng), wild(rng));  // 25 % gross outliers
+    obs.push_back(o);
+  }
+  rgbl::Vector6d offset;
+  offset << 0.5, -0.3, 1.2, 0.03, 0.02, -0.02;
+  rgbl::PoseOptimizerOptions options;
+  options.cauchy = true;
+  const auto result = rgbl::optimize_pose(cam, rgbl::se3_exp(offset) * T_true, obs, options);
+  const Eigen::Isometry3d E = result.T_cam_world * T_true.inverse();
+  CHECK(E.translation().norm() < 0.02);
+  CHECK(rgbl::rotation_angle(E.linear()) < 1e-3);
+  CHECK(result.inliers >= 200);
+}

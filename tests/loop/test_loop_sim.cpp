@@ -182,14 +182,17 @@ TEST_CASE("loop closer: two laps closed when the second is driven a lane to the 
   options.path.loop_laps = 2;
   options.path.loop_lap_offset = -3.3;
   const Lap lap = generate(options);
-  const Run with = track(lap, true);
+  const Run with = track(lap, true, kDrifting);
   const int closures = check_closures(lap, with, 90);
   fmt::print("two laps of a 100 m loop, the second a lane to the left: {} closures, ATE {:.3f} m\n", closures,
              with.ate);
   // measured: 2 closures (frame 97 with frame 0 by the bag of words, 191 with 80 by Scan Context),
   // ATE 0.108 m (0.054 m on the same track; 1.438 m there without loop closing); since keyframes keep
   // the tracked motion (2026-11-28): 1 closure, 0.059 m; since keyframes come when the established
-  // landmarks thin out: frame 97 with frame 18, 17.8 m apart, 0.043 m
+  // landmarks thin out: frame 97 with frame 18, 17.8 m apart, 0.043 m. Tracked without the scans' pair
+  // (kDrifting) since the tracker's Cauchy weights (2026-12-06): with the pair the laps drift so little
+  // that every loop found only confirms the map (e.g. keyframe 22 with 1, 0.048 m off: no correction;
+  // ATE 0.029 m), which tests nothing of the lane. Without it: 1 closure, ATE 0.038 m.
   CHECK(closures >= 1);
   CHECK(with.loops.implausible == 0);
   CHECK(with.ate < 0.16);

@@ -193,13 +193,15 @@ TEST_CASE("the settings file's Tracking keys reach the tracker") {
   CHECK(defaults.reference_landmark_ratio == 0.25);
   CHECK(defaults.pose.bounded_depth_error);
   CHECK(defaults.register_gaps);
+  CHECK(defaults.pose.cauchy);
   CHECK_FALSE(defaults.object_test);
   o.settings = dir.write("t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0\nTracking.BoundedDepthError: 0\n"
-                                   "Tracking.RegisterGaps: 0\nTracking.ObjectTest: 1\n");
+                                   "Tracking.RegisterGaps: 0\nTracking.CauchyWeights: 0\nTracking.ObjectTest: 1\n");
   const rgbl::TrackerOptions set = rgbl::Pipeline(o).system_options().tracker;
   CHECK(set.reference_landmark_ratio == 0.0);
   CHECK_FALSE(set.pose.bounded_depth_error);
   CHECK_FALSE(set.register_gaps);
+  CHECK_FALSE(set.pose.cauchy);
   CHECK(set.object_test);
 }
 

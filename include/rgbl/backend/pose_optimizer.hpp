@@ -28,9 +28,12 @@ struct PoseOptimizerOptions {
   double chi2_2d = 5.991;      // 95% of chi2 with 2 dof
   double chi2_3d = 7.815;      // 95% of chi2 with 3 dof
   bool robust_last_round = false;  // ORB-SLAM drops the robust kernel in the last rounds
-  // Huber's influence never vanishes: a few points with a small depth sigma that move with the camera
-  // (a car ahead) pull the first round off. With cauchy the influence of residuals far beyond the
-  // threshold fades (weight 1 / (1 + e^2 / c^2)).
+  // Huber's influence never vanishes: points that err together (a car ahead at about the camera's
+  // speed, a repeated pattern matched one period off) pull the pose their way, and the outlier rounds
+  // then keep them. With cauchy the rounds after the first weigh a residual by 1 / (1 + e^2 / c^2), c^2
+  // the chi2 threshold, so their influence fades. The first round stays Huber's: from a start off the
+  // pose (a gap, a relocalisation) fading weights can settle on whichever consensus is nearest, e.g. a
+  // repeated street one period short (docs/accuracy.md, "Cauchy weights after a Huber round").
   bool cauchy = false;
   double min_depth = 1e-3;     // points closer than this to the camera plane are outliers
   // The depth error beyond the measured depth d as (z - d) d / z (bounded by d as z grows, as ORB-SLAM's

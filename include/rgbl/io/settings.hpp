@@ -20,6 +20,8 @@
 //   return of the scan samples turned up by it, e.g. KITTI's HDL-64 0.205; not the depth),
 //   rgbl's own Tracking.ReferenceLandmarkRatio (TrackerOptions::reference_landmark_ratio, 0..1) and
 //   Tracking.BoundedDepthError (0/1, PoseOptimizerOptions::bounded_depth_error of the tracker),
+//   Tracking.CauchyWeights (0/1, PoseOptimizerOptions::cauchy of the tracker: Cauchy weights after a
+//   Huber round, default 1),
 //   Tracking.ObjectTest (0/1, TrackerOptions::object_test: objects whose residuals err together left out),
 //   Tracking.RegisterGaps (0/1, TrackerOptions::register_gaps: the scans registered across a gap),
 //   Tracking.RegisterLost (0/1, TrackerOptions::register_lost: a lost frame placed by its scan),
@@ -108,6 +110,7 @@ struct Settings {
   std::optional<double> lidar_pair_agreeing_sigma;
   std::optional<double> reference_landmark_ratio;  // Tracking.ReferenceLandmarkRatio
   std::optional<bool> bounded_depth_error;          // Tracking.BoundedDepthError
+  std::optional<bool> cauchy_weights;               // Tracking.CauchyWeights
   std::optional<bool> object_test;                  // Tracking.ObjectTest
   std::optional<bool> register_gaps;                // Tracking.RegisterGaps
   std::optional<bool> register_lost;                // Tracking.RegisterLost

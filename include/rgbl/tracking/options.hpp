@@ -211,7 +211,9 @@ struct TrackerOptions {
 
   // The depth error bounded beyond the measured depth: denser maps hold landmarks that bundle
   // adjustment pushed far down near-parallel rays, whose metric depth error would outweigh every true match.
-  PoseOptimizerOptions pose{.bounded_depth_error = true};
+  // Cauchy weights after the first round: points that err together pull the pose less (docs/accuracy.md,
+  // "Cauchy weights after a Huber round").
+  PoseOptimizerOptions pose{.cauchy = true, .bounded_depth_error = true};
 
   void validate() const;
 };
