@@ -186,7 +186,9 @@ double landing_share(const ScanAgreement& agreement, const ScanSample& sample, c
 }
 
 // One ICP run from `guess`: the pose, whether it converged, the last iteration's correspondences and
-// the iterations taken; nullopt when too few correspondences or a singular system.
+// the iterations taken; nullopt when too few correspondences or a singular system. With keep_short, a run
+// that falls short of min_correspondences after its first iteration returns where it got to, not
+// converged (the search ranks such starts by their landing share).
 struct IcpRun {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   bool converged = false;
@@ -195,7 +197,7 @@ struct IcpRun {
 };
 
 std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, const Eigen::Isometry3d& guess,
-                              const ScanRegistrationOptions& options) {
+                              const ScanRegistrationOptions& options, bool keep_short = false) {
   using Matrix6d = Eigen::Matrix<double, 6, 6>;
   const double converged_rad = options.converged_deg * std::numbers::pi / 180.0;
   const double scale2 = options.robust_scale * options.robust_scale;
@@ -263,7 +265,10 @@ std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, co
     }
     run.correspondences = used;
     run.iterations = iteration + 1;
-    if (used < options.min_correspondences) return std::nullopt;
+    if (used < options.min_correspondences) {
+      if (keep_short && iteration > 0) return run;
+      return std::nullopt;
+    }
     const Eigen::LDLT<Matrix6d> solver(H);
     if (solver.info() != Eigen::Success) return std::nullopt;
     const Vector6d xi = -solver.solve(g);
@@ -335,7 +340,10 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
           T_reference_query_guess *
           Eigen::Isometry3d(Eigen::AngleAxisd(yaw * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()));
       start.translation() += along * travel;
-      if (const auto run = run_icp(grid, coarse, start, search)) {
+      // a start short of correspondences at the fine distance still ranks: where moving trucks fill the
+      // scans, no start keeps enough of the coarse points within it (traffic seed 3 braking through a
+      // 1.1 s gap), yet the one nearest the truth refines to it below
+      if (const auto run = run_icp(grid, coarse, start, search, true)) {
         slots[k].emplace(landing_share(agreement, coarse, run->T), run->T);
       }
     });
