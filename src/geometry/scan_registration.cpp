@@ -186,9 +186,7 @@ double landing_share(const ScanAgreement& agreement, const ScanSample& sample, c
 }
 
 // One ICP run from `guess`: the pose, whether it converged, the last iteration's correspondences and
-// the iterations taken; nullopt when too few correspondences or a singular system. With keep_short, a run
-// that falls short of min_correspondences after its first iteration returns where it got to, not
-// converged (the search ranks such starts by their landing share).
+// the iterations taken.
 struct IcpRun {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   bool converged = false;
@@ -196,6 +194,9 @@ struct IcpRun {
   int iterations = 0;
 };
 
+// nullopt when too few correspondences or a singular system. With keep_short, a run that falls short of
+// min_correspondences after its first iteration returns where it got to, not converged (the search
+// ranks such starts by their landing share).
 std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, const Eigen::Isometry3d& guess,
                               const ScanRegistrationOptions& options, bool keep_short = false) {
   using Matrix6d = Eigen::Matrix<double, 6, 6>;
