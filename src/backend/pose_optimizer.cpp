@@ -15,6 +15,53 @@ void PoseOptimizerOptions::validate() const {
   require(chi2_2d > 0.0 && chi2_3d > 0.0, "pose_optimizer.chi2", "> 0");
 }
 
+void PoseMotionPrior::validate() const {
+  require(std::abs(direction_cam.norm() - 1.0) < 1e-6, "pose_motion_prior.direction_cam", "a unit vector");
+  require(std::isfinite(sigma_floor_m) && sigma_floor_m > 0.0, "pose_motion_prior.sigma_floor_m", "> 0");
+  require(std::isfinite(sigma_per_m) && sigma_per_m >= 0.0, "pose_motion_prior.sigma_per_m", ">= 0");
+  require(std::isfinite(lever_m) && lever_m >= 0.0, "pose_motion_prior.lever_m", ">= 0");
+}
+
+namespace {
+
+// The camera-to-world rotation half-way between two poses' (world-to-camera) rotations.
+Eigen::Matrix3d mid_rotation_world_cam(const Eigen::Isometry3d& T_last_world, const Eigen::Isometry3d& T_cur_world,
+                                       double& turn_rad) {
+  const Eigen::Matrix3d R_cur_last = T_cur_world.linear() * T_last_world.linear().transpose();
+  const Eigen::Vector3d phi = so3_log(R_cur_last);
+  turn_rad = phi.norm();
+  // R_mid_world = exp(phi / 2) R_last_world; its transpose maps the mid camera's axes into the world
+  return (so3_exp(0.5 * phi) * T_last_world.linear()).transpose();
+}
+
+}  // namespace
+
+Eigen::Vector3d step_in_mid_frame(const Eigen::Isometry3d& T_last_world, const Eigen::Isometry3d& T_cur_world) {
+  double turn = 0.0;
+  const Eigen::Matrix3d R_world_mid = mid_rotation_world_cam(T_last_world, T_cur_world, turn);
+  const Eigen::Vector3d step_world = T_cur_world.inverse().translation() - T_last_world.inverse().translation();
+  return R_world_mid.transpose() * step_world;
+}
+
+void motion_prior_residual(const PoseMotionPrior& prior, const Eigen::Isometry3d& T_cam_world,
+                           Eigen::Vector2d& residual, Eigen::Matrix<double, 2, 6>& jacobian) {
+  double turn = 0.0;
+  const Eigen::Matrix3d R_world_mid = mid_rotation_world_cam(prior.T_last_world, T_cam_world, turn);
+  const Eigen::Vector3d d = R_world_mid * prior.direction_cam;
+  // two unit vectors across d
+  const Eigen::Vector3d a = std::abs(d.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d e1 = d.cross(a).normalized();
+  const Eigen::Vector3d e2 = d.cross(e1);
+  const Eigen::Vector3d step = T_cam_world.inverse().translation() - prior.T_last_world.inverse().translation();
+  const double sigma = prior.sigma_floor_m + prior.sigma_per_m * std::abs(d.dot(step)) + prior.lever_m * turn;
+  residual << e1.dot(step) / sigma, e2.dot(step) / sigma;
+  // the centre c = -R^T t moves by -R^T rho under T <- exp([rho; phi]) T (to first order)
+  const Eigen::Matrix3d dc_drho = -T_cam_world.linear().transpose();
+  jacobian.setZero();
+  jacobian.block<1, 3>(0, 0) = e1.transpose() * dc_drho / sigma;
+  jacobian.block<1, 3>(1, 0) = e2.transpose() * dc_drho / sigma;
+}
+
 bool pose_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world, const PoseObservation& obs,
                    Eigen::Vector3d& residual, Eigen::Matrix<double, 3, 6>& jacobian, int& dimension,
                    bool bounded_depth_error) {
@@ -57,7 +104,8 @@ bool pose_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_w
 
 PoseOptimizerResult optimize_pose(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world_initial,
                                   std::span<const PoseObservation> observations,
-                                  const PoseOptimizerOptions& options) {
+                                  const PoseOptimizerOptions& options,
+                                  const std::optional<PoseMotionPrior>& motion_prior) {
   PoseOptimizerResult result;
   result.T_cam_world = T_cam_world_initial;
   result.inlier.assign(observations.size(), true);
@@ -93,6 +141,13 @@ PoseOptimizerResult optimize_pose(const PinholeCamera& camera, const Eigen::Isom
         ++used;
       }
       if (used < 3) break;
+      if (motion_prior) {
+        Eigen::Vector2d rp;
+        Eigen::Matrix<double, 2, 6> Jp;
+        motion_prior_residual(*motion_prior, result.T_cam_world, rp, Jp);
+        H.noalias() += Jp.transpose() * Jp;
+        g.noalias() += Jp.transpose() * rp;
+      }
       const Vector6d dx = H.ldlt().solve(-g);
       if (!dx.allFinite()) break;
       result.T_cam_world = se3_exp(dx) * result.T_cam_world;

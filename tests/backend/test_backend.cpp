@@ -285,3 +285,100 @@ TEST_CASE("pose optimisation: cauchy weights after a huber round keep fewer of t
   CHECK(wrong_cauchy < 0.9 * wrong_huber);
   CHECK(error_cauchy < 0.012);
 }
+
+TEST_CASE("pose motion prior: the step across the direction of travel, in sigmas that grow with the step and the turn") {
+  const Eigen::Isometry3d T_last = test_pose();
+  rgbl::PoseMotionPrior prior;
+  prior.T_last_world = T_last;
+  prior.direction_cam = Eigen::Vector3d(0.02, 0.01, 1.0).normalized();  // a mount slightly yawed and pitched
+  REQUIRE_NOTHROW(prior.validate());
+  // a camera centre 2 m along the direction from the last one, then moved across it
+  const auto moved = [&](const Eigen::Vector3d& offset_cam) {
+    Eigen::Isometry3d T = T_last;
+    T.translation() = T_last.translation() - (2.0 * prior.direction_cam + offset_cam);
+    return T;
+  };
+  Eigen::Vector2d r;
+  Eigen::Matrix<double, 2, 6> J;
+  rgbl::motion_prior_residual(prior, moved(Eigen::Vector3d::Zero()), r, J);
+  CHECK(r.norm() < 1e-12);
+  // 0.05 m across (the along part stays 2 m): sigma 0.01 + 0.035 * 2
+  const Eigen::Vector3d across = prior.direction_cam.cross(Eigen::Vector3d::UnitY()).normalized();
+  rgbl::motion_prior_residual(prior, moved(0.05 * across), r, J);
+  CHECK(r.norm() == Approx(0.05 / 0.08).epsilon(1e-9));
+  // the centre's Jacobian against numeric differentiation (on the line, where sigma's own change
+  // does not count); the rotation's columns are held (the direction turns with the camera)
+  const Eigen::Isometry3d T = moved(Eigen::Vector3d::Zero());
+  rgbl::motion_prior_residual(prior, T, r, J);
+  for (int k = 0; k < 3; ++k) {
+    rgbl::Vector6d d = rgbl::Vector6d::Zero();
+    d(k) = 1e-6;
+    Eigen::Vector2d rp, rm;
+    Eigen::Matrix<double, 2, 6> unused;
+    rgbl::motion_prior_residual(prior, rgbl::se3_exp(d) * T, rp, unused);
+    rgbl::motion_prior_residual(prior, rgbl::se3_exp(-d) * T, rm, unused);
+    CHECK(((rp - rm) / 2e-6 - J.col(k)).norm() < 1e-5 * (1.0 + J.norm()));
+  }
+  CHECK(J.rightCols<3>().norm() == 0.0);
+  // a step along an arc reads as straight ahead half-way through the turn, and a turn widens sigma
+  const double turn = 0.05;  // rad
+  Eigen::Isometry3d T_arc = T_last;
+  T_arc.linear() = rgbl::so3_exp(Eigen::Vector3d(0.0, turn, 0.0)) * T_last.linear();
+  const Eigen::Matrix3d R_world_mid = (rgbl::so3_exp(Eigen::Vector3d(0.0, 0.5 * turn, 0.0)) * T_last.linear()).transpose();
+  const Eigen::Vector3d centre = T_last.inverse().translation() + R_world_mid * (2.0 * prior.direction_cam + 0.05 * across);
+  T_arc.translation() = -(T_arc.linear() * centre);
+  CHECK((rgbl::step_in_mid_frame(T_last, T_arc) - (2.0 * prior.direction_cam + 0.05 * across)).norm() < 1e-9);
+  rgbl::motion_prior_residual(prior, T_arc, r, J);
+  CHECK(r.norm() == Approx(0.05 / (0.08 + 2.0 * turn)).epsilon(1e-9));
+
+  prior.sigma_floor_m = 0.0;
+  CHECK_THROWS_AS(prior.validate(), rgbl::ConfigError);
+}
+
+TEST_CASE("pose optimisation with a motion prior: matches that err together pull the pose less across the direction of travel") {
+  // The cauchy test's scene: 45 % of the matches 7-13 px off the same way, as crossing traffic while
+  // the car stands at the lights (the last frame's pose is the true one). The prior leaves the step
+  // along the camera's axis to the matches and holds it across (sigma 0.01 m standing). Fixed seeds,
+  // so the figures are exact: over 20 scenes the pose is off across by 9.1 mm without the prior
+  // and 5.2 mm with it, along by 5.6 and 3.6 mm.
+  const auto cam = rgbl::test::kitti_camera();
+  const Eigen::Isometry3d T_true = test_pose();
+  rgbl::PoseMotionPrior prior;
+  prior.T_last_world = T_true;
+  rgbl::PoseOptimizerOptions options;
+  options.cauchy = true;
+  double across_free = 0.0, across_prior = 0.0, along_free = 0.0, along_prior = 0.0;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    std::mt19937 rng(seed);
+    const auto points = scene(rng, T_true, 200);
+    std::normal_distribution<double> px_noise(0.0, 1.0), unit(0.0, 1.0);
+    std::uniform_real_distribution<double> share(0.0, 1.0), spread(-3.0, 3.0);
+    std::vector<rgbl::PoseObservation> obs;
+    for (const auto& p : points) {
+      const Eigen::Vector3d pc = T_true * p;
+      rgbl::PoseObservation o;
+      o.p_world = p;
+      o.pixel = cam.project_unchecked(pc) + Eigen::Vector2d(px_noise(rng), px_noise(rng));
+      o.depth_sigma = 0.01 * pc.z();
+      o.depth = pc.z() + o.depth_sigma * unit(rng);
+      if (share(rng) < 0.45) o.pixel += Eigen::Vector2d(10.0 + spread(rng), spread(rng));
+      obs.push_back(o);
+    }
+    rgbl::Vector6d start;
+    start << 0.03, -0.03, 0.3, 0.006, 0.003, -0.003;
+    const auto solve = [&](const std::optional<rgbl::PoseMotionPrior>& with, double& across, double& along) {
+      const auto r = rgbl::optimize_pose(cam, rgbl::se3_exp(start) * T_true, obs, options, with);
+      // the error of the centre in the true camera's axes: x, y across, z along
+      const Eigen::Vector3d e = T_true.linear() * (r.T_cam_world.inverse().translation() - T_true.inverse().translation());
+      across += e.head<2>().norm() / 20.0;
+      along += std::abs(e.z()) / 20.0;
+    };
+    solve(std::nullopt, across_free, along_free);
+    solve(prior, across_prior, along_prior);
+  }
+  INFO("across: free " << across_free << " m, prior " << across_prior << " m; along: free " << along_free
+                       << " m, prior " << along_prior << " m");
+  CHECK(across_prior < 0.65 * across_free);
+  CHECK(along_prior < along_free);
+  CHECK(across_prior < 0.006);
+}

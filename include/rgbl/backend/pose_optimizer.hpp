@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -45,6 +46,33 @@ struct PoseOptimizerOptions {
   void validate() const;
 };
 
+// A car moves along its heading: between two frames its camera's centre moves along the car's direction
+// of travel, which in the camera's own frame is fixed by the mount (yaw and pitch against the car's
+// axis). Across it the centre moves only by the body's sway on its springs, by the pitch under braking
+// or on a change of slope, and in a turn by the camera's lever ahead of the rear axle. A soft prior on
+// the step across that direction, none along it (braking, gaps and standing still stay free): crossing
+// traffic or a group of matches on a vehicle can pull a pose sideways or up, which no car does.
+struct PoseMotionPrior {
+  Eigen::Isometry3d T_last_world = Eigen::Isometry3d::Identity();  // the previous frame's pose
+  Eigen::Vector3d direction_cam = Eigen::Vector3d::UnitZ();  // unit; in the camera frame half-way through the turn
+  // Across the direction, sigma = sigma_floor_m + sigma_per_m * |step along| + lever_m * turn (rad).
+  double sigma_floor_m = 0.01;  // the body's sway: roll or pitch of ~0.5 deg at 1-1.5 m above the axle
+  double sigma_per_m = 0.035;   // 2 deg: pitch under braking or on a crest, and the direction's own error
+  double lever_m = 2.0;         // a camera up to 2 m ahead of the rear axle slides out by that times the turn
+
+  void validate() const;
+};
+
+// The step from T_last_world's camera centre to T_cur_world's, in the camera frame turned half-way
+// between the two (so that a step along an arc reads as straight ahead); the direction a
+// PoseMotionPrior is learned from.
+Eigen::Vector3d step_in_mid_frame(const Eigen::Isometry3d& T_last_world, const Eigen::Isometry3d& T_cur_world);
+
+// Whitened residual of a PoseMotionPrior at T_cam_world (2 entries across the direction) and its
+// Jacobian for the left perturbation of pose_residual (the direction and sigma held at T_cam_world).
+void motion_prior_residual(const PoseMotionPrior& prior, const Eigen::Isometry3d& T_cam_world,
+                           Eigen::Vector2d& residual, Eigen::Matrix<double, 2, 6>& jacobian);
+
 struct PoseOptimizerResult {
   Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();
   std::vector<bool> inlier;    // per observation
@@ -62,8 +90,10 @@ bool pose_residual(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_w
                    bool bounded_depth_error = false);
 
 // Distortion of the camera is ignored: keypoints are expected in rectified, undistorted images.
+// With a motion prior, it is added to every iteration (it never counts as an inlier nor in final_chi2).
 PoseOptimizerResult optimize_pose(const PinholeCamera& camera, const Eigen::Isometry3d& T_cam_world_initial,
                                   std::span<const PoseObservation> observations,
-                                  const PoseOptimizerOptions& options = {});
+                                  const PoseOptimizerOptions& options = {},
+                                  const std::optional<PoseMotionPrior>& motion_prior = std::nullopt);
 
 }  // namespace rgbl
