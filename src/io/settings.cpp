@@ -420,6 +420,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.bounded_depth_error = flag("Tracking.BoundedDepthError");
   s.cauchy_weights = flag("Tracking.CauchyWeights");
   s.object_test = flag("Tracking.ObjectTest");
+  s.direction_prior = flag("Tracking.DirectionPrior");
   s.register_gaps = flag("Tracking.RegisterGaps");
   s.register_lost = flag("Tracking.RegisterLost");
 

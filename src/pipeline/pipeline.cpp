@@ -96,6 +96,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.bounded_depth_error) p.system.tracker.pose.bounded_depth_error = *s.bounded_depth_error;
   if (s.cauchy_weights) p.system.tracker.pose.cauchy = *s.cauchy_weights;
   if (s.object_test) p.system.tracker.object_test = *s.object_test;
+  if (s.direction_prior) p.system.tracker.direction_prior = *s.direction_prior;
   if (s.register_gaps) p.system.tracker.register_gaps = *s.register_gaps;
   if (s.register_lost) p.system.tracker.register_lost = *s.register_lost;
   if (s.bf || s.th_depth) {

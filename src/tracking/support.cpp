@@ -1,5 +1,7 @@
 #include "rgbl/tracking/support.hpp"
 
+#include "rgbl/backend/pose_optimizer.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -84,6 +86,26 @@ StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry
     check.plausible = false;
   }
   return check;
+}
+
+void TravelDirection::add(const Eigen::Isometry3d& T_last_world, const Eigen::Isometry3d& T_cur_world,
+                          const TrackerOptions& options) {
+  const Eigen::Vector3d step = step_in_mid_frame(T_last_world, T_cur_world);
+  const double length = step.norm();
+  if (!(length >= options.direction_min_step_m)) return;
+  Eigen::Vector3d u = step / length;
+  if (seen_m_ > 0.0 && u.dot(mean_) < 0.0) u = -u;
+  const double w = std::min(1.0, length);
+  // the mean of every step seen: the mount does not move, and a running mean over the last metres
+  // would learn the tracker's own passing errors back into the prior
+  const double rate = w / (seen_m_ + w);
+  mean_ = (mean_ + rate * (u - mean_)).normalized();
+  seen_m_ += w;
+}
+
+std::optional<Eigen::Vector3d> TravelDirection::direction(const TrackerOptions& options) const {
+  if (seen_m_ < options.direction_learned_m) return std::nullopt;
+  return mean_;
 }
 
 }  // namespace rgbl

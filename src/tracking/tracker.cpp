@@ -574,6 +574,7 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
       velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
       velocity_dt_ = frame.timestamp - last_frame_->timestamp;
       velocity_steady_ = consecutive && first.motion_ok && !h.relocalised;
+      if (consecutive && !h.relocalised && !h.jump) travel_.add(last_frame_->T_cam_world, frame.T_cam_world, options_);
     }
     // a frame placed at the prediction has no observations worth a keyframe; a full mapping queue
     // takes none (those waiting refresh the map soon)
@@ -701,7 +702,21 @@ bool Tracker::initialise(Frame& frame, const Eigen::Isometry3d& T_cam_world) {
   return true;
 }
 
-int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra) const {
+std::optional<PoseMotionPrior> Tracker::motion_prior() const {
+  if (!options_.direction_prior || !last_frame_ || !has_pose(state_)) return std::nullopt;
+  const std::optional<Eigen::Vector3d> direction = travel_.direction(options_);
+  if (!direction) return std::nullopt;
+  PoseMotionPrior prior;
+  prior.T_last_world = last_frame_->T_cam_world;
+  prior.direction_cam = *direction;
+  prior.sigma_floor_m = options_.direction_prior_floor_m;
+  prior.sigma_per_m = options_.direction_prior_per_m;
+  prior.lever_m = options_.direction_prior_lever_m;
+  return prior;
+}
+
+int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra,
+                           bool relocalising) const {
   std::vector<PoseObservation> observations;
   std::vector<std::size_t> keypoint_of;
   observations.reserve(frame.size());
@@ -731,10 +746,11 @@ int Tracker::optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t
   }
   for (const auto& [i, p_world] : extra) add(i, p_world);
   if (observations.size() < static_cast<std::size_t>(options_.min_pose_inliers)) return 0;
-  PoseOptimizerResult result = optimize_pose(camera_, frame.T_cam_world, observations, options_.pose);
+  const std::optional<PoseMotionPrior> prior = relocalising ? std::nullopt : motion_prior();
+  PoseOptimizerResult result = optimize_pose(camera_, frame.T_cam_world, observations, options_.pose, prior);
   if (options_.object_test && result.inliers >= options_.min_pose_inliers &&
       leave_out_erring_objects(frame, observations, keypoint_of, result.T_cam_world, result.inlier)) {
-    result = optimize_pose(camera_, result.T_cam_world, observations, options_.pose);
+    result = optimize_pose(camera_, result.T_cam_world, observations, options_.pose, prior);
   }
   frame.T_cam_world = result.T_cam_world;
   for (std::size_t j = 0; j < observations.size(); ++j) frame.outlier[keypoint_of[j]] = !result.inlier[j];
@@ -1058,7 +1074,7 @@ Tracker::LocalMapResult Tracker::track_local_map(Frame& frame, KeyframeId refere
                                  static_cast<float>(options_.depth_gate_min_local_map)};
     detail::match_projected(frame, candidates, options_.max_hamming, options_.local_map_ratio, false, nullptr, gate);
   }
-  result.inliers = optimise_pose(frame);
+  result.inliers = optimise_pose(frame, {}, relocalisation_frame == frame.index);
   for (std::size_t i = 0; i < frame.size(); ++i) {
     if (frame.landmarks[i].valid() && !frame.outlier[i]) views.found.push_back(frame.landmarks[i]);
   }
@@ -1115,7 +1131,7 @@ bool Tracker::relocalise(Frame& frame) const {
     const auto& [q, t] = matches[static_cast<std::size_t>(i)];
     frame.landmarks[static_cast<std::size_t>(q)] = ids[static_cast<std::size_t>(t)];
   }
-  const int inliers = optimise_pose(frame);
+  const int inliers = optimise_pose(frame, {}, true);
   discard_outliers(frame);
   return inliers >= options_.min_pose_inliers;
 }

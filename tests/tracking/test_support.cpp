@@ -4,6 +4,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -230,4 +231,51 @@ TEST_CASE("support: the motion model is suspect when the map or the recent frame
     e.last_inliers = 160;
     CHECK(rgbl::motion_suspect(e, options));
   }
+}
+
+TEST_CASE("support: the direction of travel is learned in the camera's frame, on an arc and backing up",
+          "[tracking][support]") {
+  // A camera mounted 1.5 deg to the left of the car's axis and pitched 0.8 deg down drives a 30 m
+  // radius arc at 1 m a frame; the car's axis stays on the arc's tangent (the rear axle's path), so
+  // in the camera's frame the car moves along a fixed direction.
+  const double yaw = 1.5 * std::numbers::pi / 180.0, pitch = 0.8 * std::numbers::pi / 180.0;
+  const Eigen::Matrix3d R_car_cam = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()) *
+                                     Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitX())).toRotationMatrix();
+  const Eigen::Vector3d expected = R_car_cam.transpose() * Eigen::Vector3d::UnitZ();
+  const auto camera_on_arc = [&](double s) {  // s metres along the arc (x right, z forward in the world)
+    const double radius = 30.0, heading = s / radius;
+    Eigen::Isometry3d T_world_car = Eigen::Isometry3d::Identity();
+    T_world_car.linear() = Eigen::AngleAxisd(-heading, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    T_world_car.translation() = Eigen::Vector3d(-radius * (1.0 - std::cos(heading)), 0.0, radius * std::sin(heading));
+    Eigen::Isometry3d T_world_cam = T_world_car;
+    T_world_cam.linear() = T_world_car.linear() * R_car_cam;
+    return T_world_cam.inverse();
+  };
+  rgbl::TrackerOptions options;  // learned after 3 m of steps of at least 0.2 m
+  rgbl::TravelDirection travel;
+  const auto angle_deg = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+  };
+  for (int i = 1; i <= 2; ++i) travel.add(camera_on_arc(i - 1.0), camera_on_arc(i), options);
+  CHECK_FALSE(travel.direction(options).has_value());  // 2 m seen
+  travel.add(camera_on_arc(2.0), camera_on_arc(2.1), options);  // too short to give a direction: not counted
+  CHECK_FALSE(travel.direction(options).has_value());
+  travel.add(camera_on_arc(2.0), camera_on_arc(3.0), options);
+  travel.add(camera_on_arc(3.0), camera_on_arc(4.0), options);  // the chords are a little under 1 m
+  REQUIRE(travel.direction(options).has_value());
+  CHECK(angle_deg(*travel.direction(options), expected) < 1e-6);
+  // the arc's chord is read half-way through the turn, so the direction does not move on the arc...
+  for (int i = 4; i < 40; ++i) travel.add(camera_on_arc(i), camera_on_arc(i + 1.0), options);
+  CHECK(angle_deg(*travel.direction(options), expected) < 1e-6);
+  // ...nor when the car backs up along it (half-metre steps)
+  for (int i = 40; i > 30; --i) travel.add(camera_on_arc(i), camera_on_arc(i - 0.5), options);
+  CHECK(angle_deg(*travel.direction(options), expected) < 1e-6);
+  // a step 10 deg off moves the mean by its share of every step seen: 1 m of about 44 m, 0.22 deg
+  const Eigen::Isometry3d T_last = camera_on_arc(30.0);
+  Eigen::Isometry3d T_off = T_last;
+  const Eigen::Vector3d off_cam = Eigen::AngleAxisd(10.0 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitY()) * expected;
+  T_off.translation() = T_last.translation() - off_cam;  // the centre 1 m along off_cam, no turn
+  travel.add(T_last, T_off, options);
+  CHECK(angle_deg(*travel.direction(options), expected) > 0.2);
+  CHECK(angle_deg(*travel.direction(options), expected) < 0.25);
 }

@@ -23,6 +23,8 @@
 //   Tracking.CauchyWeights (0/1, PoseOptimizerOptions::cauchy of the tracker: Cauchy weights after a
 //   Huber round, default 1),
 //   Tracking.ObjectTest (0/1, TrackerOptions::object_test: objects whose residuals err together left out),
+//   Tracking.DirectionPrior (0/1, TrackerOptions::direction_prior: the step held across the car's
+//   direction of travel, default 1),
 //   Tracking.RegisterGaps (0/1, TrackerOptions::register_gaps: the scans registered across a gap),
 //   Tracking.RegisterLost (0/1, TrackerOptions::register_lost: a lost frame placed by its scan),
 //   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
@@ -112,6 +114,7 @@ struct Settings {
   std::optional<bool> bounded_depth_error;          // Tracking.BoundedDepthError
   std::optional<bool> cauchy_weights;               // Tracking.CauchyWeights
   std::optional<bool> object_test;                  // Tracking.ObjectTest
+  std::optional<bool> direction_prior;              // Tracking.DirectionPrior
   std::optional<bool> register_gaps;                // Tracking.RegisterGaps
   std::optional<bool> register_lost;                // Tracking.RegisterLost
   std::vector<std::string> warnings;  // unknown keys, one message each

@@ -104,4 +104,19 @@ StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry
 StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry3d& T_cam_world_predicted,
                      const Eigen::Vector3d& last_centre, double dt, const TrackerOptions& options);
 
+// The car's direction of travel in the camera's frame (the mount's yaw and pitch against the car's
+// axis), learned from tracked steps long enough to give a direction: each step in the camera frame
+// turned half-way through it (step_in_mid_frame), weighted by its length up to 1 m, into the mean of
+// all unit vectors seen (reversing counts as the same line). It is the direction of the tracker's motion prior
+// (TrackerOptions::direction_prior) once steps of direction_learned_m in all have been seen.
+class TravelDirection {
+ public:
+  void add(const Eigen::Isometry3d& T_last_world, const Eigen::Isometry3d& T_cur_world, const TrackerOptions& options);
+  std::optional<Eigen::Vector3d> direction(const TrackerOptions& options) const;
+
+ private:
+  Eigen::Vector3d mean_ = Eigen::Vector3d::UnitZ();
+  double seen_m_ = 0.0;
+};
+
 }  // namespace rgbl

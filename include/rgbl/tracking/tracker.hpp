@@ -9,6 +9,7 @@
 // and commit() makes it the tracker's state, once. The local-map searches of every hypothesis tried
 // count towards the landmarks' visible/found ratios (committed with the frame).
 
+#include "rgbl/backend/pose_optimizer.hpp"
 #include "rgbl/geometry/camera.hpp"
 #include "rgbl/geometry/point_cloud.hpp"
 #include "rgbl/map/map.hpp"
@@ -204,8 +205,13 @@ class Tracker {
   bool relocalisation_confirmed(const LocalMapResult& local) const;
   // After a loss: is a relocalised pose where the vehicle can be since the last tracked frame?
   bool within_reach(const Frame& frame, const Prediction& prediction) const;
-  // extra: (keypoint, world point) correspondences that are not landmarks (temporary points).
-  int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {}) const;
+  // extra: (keypoint, world point) correspondences that are not landmarks (temporary points). The
+  // direction prior holds while the last frame was tracked, except for a relocalisation (which must
+  // not lean on the last pose).
+  int optimise_pose(Frame& frame, const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& extra = {},
+                    bool relocalising = false) const;
+  // TrackerOptions::direction_prior for a frame after last_frame_, if it applies.
+  std::optional<PoseMotionPrior> motion_prior() const;
   // TrackerOptions::object_test after a pose optimisation (at T_cam_world, with its inliers): removes
   // the observations of objects that err together, labels their keypoints moving and outliers and
   // their landmarks moved. True when it removed any (the pose is then optimised again).
@@ -238,6 +244,7 @@ class Tracker {
   std::optional<Eigen::Isometry3d> velocity_;  // T_cur_last
   double velocity_dt_ = 0.0;  // timestamp difference of that pair (0 = unknown)
   bool velocity_steady_ = false;  // velocity_ comes from two consecutive tracked frames (no relocalisation)
+  TravelDirection travel_;  // the direction prior's direction
 };
 
 }  // namespace rgbl
