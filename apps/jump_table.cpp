@@ -6,6 +6,7 @@
 // which a truth with its own heading error (KITTI raw's OXTS) does not blur. One line per run
 // (scripts/jump-table.sh runs a table of them).
 #include "rgbl/core/log.hpp"
+#include "rgbl/core/task_pool.hpp"
 #include "rgbl/eval/trajectory_metrics.hpp"
 #include "rgbl/geometry/se3.hpp"
 #include "rgbl/pipeline/pipeline.hpp"
@@ -18,6 +19,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -34,10 +36,12 @@ struct Run {
   std::vector<Eigen::Isometry3d> truth;             // T_world_cam0 per fed frame
 };
 
-Run track(const rgbl::Pipeline& pipeline, std::size_t last, std::size_t resume, bool bridge) {
+Run track(const rgbl::Pipeline& pipeline, std::size_t last, std::size_t resume, bool bridge,
+          const std::shared_ptr<rgbl::TaskPool>& pool) {
   rgbl::SystemOptions options = pipeline.system_options();
   options.loop_closing.bridge.enabled = bridge;
   rgbl::System system(options, pipeline.calibration(), pipeline.make_depth_source(), pipeline.make_extractor());
+  system.use_task_pool(pool);  // the scans' registration across the gap and the bridge
   const rgbl::Sequence& sequence = pipeline.sequence();
   Run run;
   for (std::size_t i = 0; i < sequence.size(); ++i) {
@@ -119,6 +123,10 @@ int main(int argc, char** argv) {
   bool per_frame = false;
   app.add_flag("--per-frame", per_frame,
                "Also print each frame of the bridged run against the gapless run: as written and as tracked");
+  int threads = 0;
+  app.add_option("--threads", threads,
+                 "Threads for the scans' registration across the gap (0 = the machine's; the result is the same)")
+      ->check(CLI::NonNegativeNumber);
   bool verbose = false;
   app.add_flag("-v,--verbose", verbose, "Print the library's debug messages (why a frame was placed where it was)");
   CLI11_PARSE(app, argc, argv);
@@ -131,9 +139,10 @@ int main(int argc, char** argv) {
     const rgbl::Pipeline pipeline(options);
     if (resume >= pipeline.sequence().size()) throw std::invalid_argument("--resume beyond the last frame");
     const Eigen::Isometry3d T_cam_cam0 = pipeline.calibration().T_cam_cam0;
-    const Run whole = track(pipeline, pipeline.sequence().size(), pipeline.sequence().size(), true);
-    const Run bridged = track(pipeline, last, resume, true);
-    const Run apart = track(pipeline, last, resume, false);
+    const auto pool = std::make_shared<rgbl::TaskPool>(threads);
+    const Run whole = track(pipeline, pipeline.sequence().size(), pipeline.sequence().size(), true, pool);
+    const Run bridged = track(pipeline, last, resume, true, pool);
+    const Run apart = track(pipeline, last, resume, false, pool);
     if (per_frame) {
       for (std::size_t k = 0; k < bridged.frames.size(); ++k) {
         const std::size_t f = bridged.frames[k];

@@ -178,15 +178,16 @@ constexpr std::string_view kBridgeSource = "lidar_bridge";
 // the new map no more than the guess can be off.
 std::optional<DetectedLoop> bridge_maps(const MapBridgeOptions& o, const Eigen::Isometry3d& T_cam_lidar,
                                         const Keyframe& last, PointCloudView last_scan, const Keyframe& current,
-                                        PointCloudView scan) {
+                                        PointCloudView scan, TaskPool* pool) {
   const double gap = current.timestamp - last.timestamp;
   if (!(gap > 0.0 && gap <= o.max_gap_s)) {
     logger()->debug("bridge: keyframes {} and {} are {:.2f} s apart (at most {:.2f} s): not registered",
                     last.id.value, current.id.value, gap, o.max_gap_s);
     return std::nullopt;
   }
+  const Stopwatch watch;
   const auto g = register_across_gap(last_scan, scan, T_cam_lidar, last.T_cam_world * current.T_cam_world.inverse(),
-                                     gap, o.registration);
+                                     gap, o.registration, pool);
   if (!g) {
     logger()->info("bridge: frame {} onto frame {}: too little to register", current.frame_index, last.frame_index);
     return std::nullopt;
@@ -196,11 +197,11 @@ std::optional<DetectedLoop> bridge_maps(const MapBridgeOptions& o, const Eigen::
   const Eigen::Isometry3d T_current_world = T_last_current.inverse() * last.T_cam_world;
   logger()->info("bridge: frame {} onto frame {} ({:.2f} s, {:.1f} m apart): {} of {} starts converged, {} "
                  "iterations, {} correspondences, agreement {:.3f} (runner-up {:.3f}), probe loss {:.3f} (>= {:.2f}), "
-                 "moves the new map {:.2f} m, {:.2f} deg (at most {:.2f} m, {:.2f} deg): {}",
+                 "moves the new map {:.2f} m, {:.2f} deg (at most {:.2f} m, {:.2f} deg): {} ({:.0f} ms)",
                  current.frame_index, last.frame_index, gap, T_last_current.translation().norm(), r.converged_starts,
                  r.starts, r.iterations, r.correspondences, r.agreement, r.runner_up_agreement, r.min_probe_loss,
                  o.registration.min_probe_loss, g->moved_m, g->moved_deg, g->allowed_m, g->allowed_deg,
-                 g->accepted ? "accepted" : "refused");
+                 g->accepted ? "accepted" : "refused", watch.elapsed_ms());
   if (!g->accepted) return std::nullopt;
   DetectedLoop loop;
   loop.keyframe = current.id;
@@ -358,7 +359,7 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
     if (options_.merge_maps && options_.bridge.enabled && T_cam_lidar_ && last != nullptr && !current->parent.valid() &&
         roots(last_keyframe_) != root && !scan.empty() && !last_scan_.empty()) {
       ++stats_.bridge_attempts;
-      best = bridge_maps(options_.bridge, *T_cam_lidar_, *last, last_scan_, *current, scan);
+      best = bridge_maps(options_.bridge, *T_cam_lidar_, *last, last_scan_, *current, scan, pool_.get());
       bridged = best.has_value();
     }
     std::vector<std::size_t> neighbours;

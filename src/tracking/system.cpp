@@ -250,6 +250,7 @@ void System::add_place_recognizer(std::unique_ptr<PlaceRecognizer> recognizer) {
 
 void System::use_task_pool(std::shared_ptr<TaskPool> pool) {
   if (!impl_->records.empty()) throw std::logic_error("System::use_task_pool: only before the first frame");
+  impl_->closer.use_task_pool(pool);
   impl_->tracker.use_task_pool(std::move(pool));
 }
 

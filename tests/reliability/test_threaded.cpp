@@ -158,35 +158,61 @@ TEST_CASE("frame threads: a raw drive's LiDAR depth finished on the tracking thr
   rgbl::test::check_thread_counts_agree(o, {3});
 }
 
-TEST_CASE("frame threads: a gap registered on the frame pool, the same poses as one thread (seq 04)") {
-  // sequence 04's frames 0-7 and 28-33 as one sequence: 2.1 s between its 8th and 9th frames, so the
-  // tracker registers the scans across the gap, on the pool that builds the frames
-  const auto sequence = rgbl::test::kitti_seq04();
-  if (!sequence) return;
-  const rgbl::test::TempDir dir;
+namespace {
+// Sequence 04's frames 0-7 and 28-33 as one sequence in `dir`: 2.1 s between its 8th and 9th frames.
+std::filesystem::path write_gap_excerpt(const rgbl::test::TempDir& dir, const std::filesystem::path& sequence) {
   const auto folder = dir.path() / "sequences" / "04";
   std::filesystem::create_directories(folder / "image_0");
   std::filesystem::create_directories(folder / "velodyne");
-  std::filesystem::copy_file(*sequence / "calib.txt", folder / "calib.txt");
-  std::ifstream all_times(*sequence / "times.txt");
+  std::filesystem::copy_file(sequence / "calib.txt", folder / "calib.txt");
+  std::ifstream all_times(sequence / "times.txt");
   std::vector<std::string> times;
   for (std::string line; std::getline(all_times, line);) times.push_back(line);
   std::string kept_times;
   int k = 0;
   for (const int i : {0, 1, 2, 3, 4, 5, 6, 7, 28, 29, 30, 31, 32, 33}) {
     const std::string from = fmt::format("{:06d}", i), to = fmt::format("{:06d}", k++);
-    std::filesystem::create_symlink(*sequence / "image_0" / (from + ".png"), folder / "image_0" / (to + ".png"));
-    std::filesystem::create_symlink(*sequence / "velodyne" / (from + ".bin"), folder / "velodyne" / (to + ".bin"));
+    std::filesystem::create_symlink(sequence / "image_0" / (from + ".png"), folder / "image_0" / (to + ".png"));
+    std::filesystem::create_symlink(sequence / "velodyne" / (from + ".bin"), folder / "velodyne" / (to + ".bin"));
     kept_times += times.at(static_cast<std::size_t>(i)) + "\n";
   }
   dir.write("sequences/04/times.txt", kept_times);
+  return folder;
+}
+}  // namespace
+
+TEST_CASE("frame threads: a gap registered on the frame pool, the same poses as one thread (seq 04)") {
+  // the tracker registers the scans across the gap, on the pool that builds the frames
+  const auto sequence = rgbl::test::kitti_seq04();
+  if (!sequence) return;
+  const rgbl::test::TempDir dir;
   rgbl::PipelineOptions o;
-  o.dataset = folder;
+  o.dataset = write_gap_excerpt(dir, *sequence);
   o.threads = 2;
   const rgbl::RunResult run = rgbl::Pipeline(o).run();
   REQUIRE(run.frames.size() == 14);
   CHECK(run.frames[8].result.gap);
   CHECK(run.frames[8].result.gap_registered);
+  rgbl::test::check_thread_counts_agree(o, {2, 3});
+}
+
+TEST_CASE("frame threads: two maps bridged on the frame pool, the same poses as one thread (seq 04)") {
+  // the same gap, not registered by the tracker: it loses the frames after it and starts a new map at
+  // frame 11, which the loop closer bridges to the old one by registering the scans, on the same pool
+  const auto sequence = rgbl::test::kitti_seq04();
+  if (!sequence) return;
+  const rgbl::test::TempDir dir;
+  rgbl::PipelineOptions o;
+  o.dataset = write_gap_excerpt(dir, *sequence);
+  o.settings = dir.write("nogaps.yaml", "%YAML:1.0\nTracking.RegisterGaps: 0\n");
+  o.threads = 2;
+  const rgbl::RunResult run = rgbl::Pipeline(o).run();
+  REQUIRE(run.frames.size() == 14);
+  CHECK(run.frames[8].result.state == rgbl::TrackState::Lost);
+  const auto& bridged = run.frames[11].result;
+  CHECK(bridged.new_map);
+  REQUIRE(bridged.loop_closure);
+  CHECK(bridged.loop_closure->bridged);
   rgbl::test::check_thread_counts_agree(o, {2, 3});
 }
 
