@@ -47,7 +47,7 @@ void ScanRegistrationOptions::validate() const {
 namespace {
 
 // One point per voxel of edge `voxel`: the mean of the voxel's returns within the range.
-ScanSample voxel_downsample(PointCloudView scan, const ScanRegistrationOptions& options, double voxel) {
+ScanSample voxel_sample(PointCloudView scan, const ScanRegistrationOptions& options, double voxel) {
   const auto min2 = static_cast<float>(options.min_range * options.min_range);
   const auto max2 = static_cast<float>(options.max_range * options.max_range);
   const auto inv = static_cast<float>(1.0 / voxel);
@@ -285,16 +285,25 @@ std::optional<IcpRun> run_icp(const PlaneGrid& grid, const ScanSample& query, co
 
 }  // namespace
 
+std::vector<LidarPoint> voxel_downsample(PointCloudView scan, const ScanRegistrationOptions& options, double voxel) {
+  require(std::isfinite(voxel) && voxel > 0.0, "voxel_downsample.voxel", "> 0 m");
+  const ScanSample sample = voxel_sample(scan, options, voxel);
+  std::vector<LidarPoint> points;
+  points.reserve(sample.points.size());
+  for (const Eigen::Vector3f& p : sample.points) points.push_back({p.x(), p.y(), p.z(), 0.0F});
+  return points;
+}
+
 std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCloudView query,
                                                const Eigen::Isometry3d& T_reference_query_guess,
                                                const ScanRegistrationOptions& options, TaskPool* pool) {
   options.validate();
-  const ScanSample reference_points = voxel_downsample(reference, options, options.reference_voxel);
-  const ScanSample query_points = voxel_downsample(query, options, options.query_voxel);
+  const ScanSample reference_points = voxel_sample(reference, options, options.reference_voxel);
+  const ScanSample query_points = voxel_sample(query, options, options.query_voxel);
   const PlaneGrid grid(reference_points, options);
   // the agreement is counted on the query at the reference's density
   const bool same_voxel = options.query_voxel == options.reference_voxel;
-  const ScanSample finer = same_voxel ? ScanSample{} : voxel_downsample(query, options, options.reference_voxel);
+  const ScanSample finer = same_voxel ? ScanSample{} : voxel_sample(query, options, options.reference_voxel);
   const ScanSample& dense = same_voxel ? query_points : finer;
   const ScanAgreement agreement(reference_points, options.agreement_tolerance);
 
@@ -328,7 +337,7 @@ std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCl
   if (start_count == 1) {
     seeds.push_back(T_reference_query_guess);
   } else {
-    const ScanSample coarse = voxel_downsample(query, options, options.search_voxel);
+    const ScanSample coarse = voxel_sample(query, options, options.search_voxel);
     ScanRegistrationOptions search = options;
     search.max_iterations = options.search_iterations;
     search.min_correspondences = std::max<std::size_t>(

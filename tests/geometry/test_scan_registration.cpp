@@ -105,6 +105,38 @@ TEST_CASE("scan registration: trunks and houses pin the pose down from a guess 1
   CHECK(r->min_probe_loss > 0.1);
 }
 
+TEST_CASE("scan registration: a reference stored at its own voxel registers as the full scan does") {
+  // voxel_downsample keeps one mean per voxel within the range: what register_scans keeps of a
+  // reference, so the loop closer's stored scans give the result the full ones would
+  const std::vector<rgbl::LidarPoint> few{{3.1F, 0.1F, 0.0F, 9.0F}, {3.3F, 0.3F, 0.2F, 9.0F},  // one voxel
+                                          {4.6F, 0.0F, 0.0F, 1.0F},                           // another
+                                          {1.0F, 0.0F, 0.0F, 1.0F}, {70.0F, 0.0F, 0.0F, 1.0F}};  // out of range
+  const rgbl::ScanRegistrationOptions options;  // 3..60 m
+  const auto kept = rgbl::voxel_downsample(few, options, 0.5);
+  REQUIRE(kept.size() == 2);
+  CHECK(kept[0].x == Approx(3.2F));
+  CHECK(kept[0].y == Approx(0.2F));
+  CHECK(kept[0].z == Approx(0.1F));
+  CHECK(kept[0].intensity == 0.0F);
+  CHECK(kept[1].x == Approx(4.6F));
+  CHECK_THROWS_AS(rgbl::voxel_downsample(few, options, 0.0), rgbl::ConfigError);
+
+  const auto scene = roadside(true);
+  const Eigen::Isometry3d truth = rgbl::make_isometry(rgbl::so3_exp({0.0, 0.0, 0.05}), {25.0, 0.4, 0.0});
+  const auto reference = seen_from(scene, Eigen::Isometry3d::Identity());
+  const auto query = seen_from(scene, truth);
+  const Eigen::Isometry3d guess = rgbl::make_isometry(rgbl::so3_exp({0.0, 0.0, 0.02}), {26.2, -0.4, 0.3});
+  const auto stored = rgbl::voxel_downsample(reference, options, options.reference_voxel);
+  CHECK(stored.size() < reference.size() / 5);
+  const auto full = rgbl::register_scans(reference, query, guess);
+  const auto from_stored = rgbl::register_scans(stored, query, guess);
+  REQUIRE(full);
+  REQUIRE(from_stored);
+  const Eigen::Isometry3d difference = full->T_reference_query.inverse() * from_stored->T_reference_query;
+  CHECK(difference.translation().norm() < 1e-4);
+  CHECK(deg(difference.linear()) < 1e-3);
+}
+
 TEST_CASE("scan registration: a corridor leaves the along-track position open, and the probe says so") {
   const auto scene = roadside(false);
   const Eigen::Isometry3d truth = rgbl::make_isometry(Eigen::Matrix3d::Identity(), {25.0, 0.0, 0.0});

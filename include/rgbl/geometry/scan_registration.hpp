@@ -19,6 +19,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <vector>
 
 namespace rgbl {
 
@@ -93,6 +94,11 @@ struct ScanRegistration {
 std::optional<ScanRegistration> register_scans(PointCloudView reference, PointCloudView query,
                                                const Eigen::Isometry3d& T_reference_query_guess,
                                                const ScanRegistrationOptions& options = {}, TaskPool* pool = nullptr);
+
+// One return per voxel of edge `voxel` (the mean of its returns, intensity 0), of the returns within
+// options' min_range..max_range: what register_scans keeps of a reference at options.reference_voxel,
+// so a scan stored this way registers as the full one would.
+std::vector<LidarPoint> voxel_downsample(PointCloudView scan, const ScanRegistrationOptions& options, double voxel);
 
 // A registration across a gap in the frames: from a constant-velocity guess over gap_s seconds,
 // searched as far as that guess can be off, and taken only as a clear, pinned-down optimum within
