@@ -402,6 +402,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.loop_closing.fuse = flag("LoopClosing.Fuse");
   s.loop_closing.global_ba = flag("LoopClosing.GlobalBA");
   s.loop_closing.merge_maps = flag("LoopClosing.MergeMaps");
+  s.loop_closing.scans = flag("LoopClosing.Scans");
   s.loop_closing.bridge = flag("LoopClosing.BridgeGaps");
   s.loop_closing.bridge_max_gap_s = r.number({"LoopClosing.BridgeMaxGap"});
   s.place_culling = flag("LocalMapping.PlaceCulling");

@@ -26,8 +26,18 @@ void MapBridgeOptions::validate() const {
   registration.validate();
 }
 
+void LoopScanOptions::validate() const {
+  require(std::isfinite(voxel) && voxel > 0.0, "loop_closing.scans.voxel", "> 0 m");
+  require(std::isfinite(min_probe_loss) && min_probe_loss >= 0.0 && min_probe_loss <= 1.0,
+          "loop_closing.scans.min_probe_loss", "a share in [0, 1]");
+  require(std::isfinite(max_change_m) && max_change_m > 0.0, "loop_closing.scans.max_change_m", "> 0 m");
+  require(std::isfinite(max_change_deg) && max_change_deg > 0.0, "loop_closing.scans.max_change_deg", "> 0 deg");
+  registration.validate();
+}
+
 void LoopClosingOptions::validate() const {
   places.validate();
+  scans.validate();
   require(max_candidates >= 1, "loop_closing.max_candidates", ">= 1 candidate");
   require(min_keyframe_gap >= 1, "loop_closing.min_keyframe_gap", ">= 1 keyframe");
   require(consistent_keyframes >= 1, "loop_closing.consistent_keyframes", ">= 1 keyframe");
@@ -312,6 +322,43 @@ double LoopCloser::record_odometry(KeyframeId keyframe, const Eigen::Vector3d& c
   return driven_total_m_;
 }
 
+void LoopCloser::keep_scan(const Map& map, KeyframeId keyframe, PointCloudView scan) {
+  if (!options_.scans.enabled || !T_cam_lidar_) return;
+  std::erase_if(scans_, [&](const auto& entry) { return map.keyframe(KeyframeId{entry.first}) == nullptr; });
+  if (!scan.empty()) scans_[keyframe.value] = voxel_downsample(scan, options_.scans.registration, options_.scans.voxel);
+}
+
+std::optional<LoopConstraint> LoopCloser::scan_refined(const LoopConstraint& c, PointCloudView current_scan) const {
+  const auto matched = scans_.find(c.matched.value);
+  const auto current = scans_.find(c.current.value);
+  const PointCloudView query = !current_scan.empty() ? current_scan
+                               : current != scans_.end() ? PointCloudView(current->second)
+                                                         : PointCloudView{};
+  if (matched == scans_.end() || query.empty()) return std::nullopt;
+  const Eigen::Isometry3d& T_cam_lidar = *T_cam_lidar_;
+  // the images' measurement between the two LiDAR frames: matched <- current
+  const Eigen::Isometry3d guess = T_cam_lidar.inverse() * c.T_current_matched.inverse() * T_cam_lidar;
+  const LoopScanOptions& o = options_.scans;
+  const auto r = register_scans(matched->second, query, guess, o.registration, pool_.get());
+  if (!r) {
+    logger()->debug("loop: keyframes {} and {}: too little in their scans to register", c.current.value,
+                    c.matched.value);
+    return std::nullopt;
+  }
+  LoopConstraint refined = c;
+  refined.T_current_matched = (T_cam_lidar * r->T_reference_query * T_cam_lidar.inverse()).inverse();
+  // the current camera's centre and turn in the matched camera's frame, images against scans
+  const PoseChange change = pose_change(c.T_current_matched, refined.T_current_matched);
+  const bool ok = r->converged && r->min_probe_loss >= o.min_probe_loss && change.m <= o.max_change_m &&
+                  change.deg <= o.max_change_deg;
+  logger()->debug("loop: keyframe {} vs {} by the scans: {:.3f} m, {:.2f} deg from the images' ({} iterations, {}, "
+                  "probe loss {:.3f}): {}",
+                  c.current.value, c.matched.value, change.m, change.deg, r->iterations,
+                  r->converged ? "converged" : "not converged", r->min_probe_loss, ok ? "taken" : "the images' kept");
+  if (!ok) return std::nullopt;
+  return refined;
+}
+
 void LoopCloser::remember(KeyframeId keyframe) {
   recent_.push_back(keyframe);
   if (std::cmp_greater(recent_.size(), options_.consistent_keyframes)) recent_.erase(recent_.begin());
@@ -344,6 +391,7 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
     std::shared_lock lock(map.mutex());
     const Keyframe* current = map.keyframe(keyframe);
     if (current == nullptr) return done();
+    keep_scan(map, keyframe, scan);
     const double driven = record_odometry(keyframe, current->center());
     Roots roots(map);
     root = roots(keyframe);
@@ -436,6 +484,19 @@ LoopCloserStep LoopCloser::detect(Map& map, KeyframeId keyframe, PointCloudView 
   stats_.implausible += step.implausible;
   if (!step.consistent) return done();
   ++stats_.consistent;
+  if (options_.scans.enabled && T_cam_lidar_ && !best->bridge) {
+    // outside the map's lock: the scans and the constraints are the loop closer's own
+    const auto measure_again = [&](LoopConstraint& c) {
+      const std::optional<LoopConstraint> refined = scan_refined(c, c.current == keyframe ? scan : PointCloudView{});
+      ++(refined ? stats_.scan_refined : stats_.scan_kept);
+      if (refined) c = *refined;
+    };
+    LoopVerification& v = best->verification;
+    const Eigen::Isometry3d T_matched_world = v.constraint.T_current_matched.inverse() * v.T_cam_world;
+    measure_again(v.constraint);
+    v.T_cam_world = v.constraint.T_current_matched * T_matched_world;
+    for (LoopConstraint& c : best->confirmations) measure_again(c);
+  }
   loop = std::move(best);
   return done();
 }

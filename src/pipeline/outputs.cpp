@@ -186,6 +186,7 @@ std::string summary_json(const RunResult& run) {
                           {"implausible", l.implausible}, {"consistent", l.consistent}, {"confirming", l.confirming},
                           {"closures", l.closures},       {"merges", l.merges},
                           {"bridge_attempts", l.bridge_attempts}, {"bridges", l.bridges},
+                          {"scan_refined", l.scan_refined}, {"scan_kept", l.scan_kept},
                           {"time_ms", json_number(l.time_ms)}};
   j["threaded_mapping"] = run.threaded;
   j["threads"] = run.threads;

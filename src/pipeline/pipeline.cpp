@@ -86,6 +86,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (l.fuse) loop.fuse = *l.fuse;
   if (l.global_ba) loop.global_ba = *l.global_ba;
   if (l.merge_maps) loop.merge_maps = *l.merge_maps;
+  if (l.scans) loop.scans.enabled = *l.scans;
   if (l.bridge) loop.bridge.enabled = *l.bridge;
   if (l.bridge_max_gap_s) loop.bridge.max_gap_s = *l.bridge_max_gap_s;
   if (s.place_culling) p.system.mapping.place_culling = *s.place_culling;

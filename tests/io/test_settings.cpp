@@ -144,6 +144,7 @@ TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
                              "LoopClosing.ConsistentKeyframes: 4\nLoopClosing.MaxDriftPercent: 5\n"
                              "LoopClosing.MaxDriftDegPer100m: 4.5\nLoopClosing.Fuse: 1\nLoopClosing.GlobalBA: 1\n"
                              "LoopClosing.MergeMaps: 0\nLoopClosing.BridgeGaps: 0\nLoopClosing.BridgeMaxGap: 2.5\n"
+                             "LoopClosing.Scans: 0\n"
                              "LoopClosing.Places: \"scan_context, bow\"\n"
                              "LoopClosing.Vocabulary: \"voc/mine.rgblvoc\"\n"));
   CHECK(s.loop_closing.enabled == false);
@@ -158,6 +159,7 @@ TEST_CASE("settings: rgbl's LoopClosing keys", "[io][settings]") {
   CHECK(s.loop_closing.merge_maps == false);
   CHECK(s.loop_closing.bridge == false);
   CHECK(s.loop_closing.bridge_max_gap_s == 2.5);
+  CHECK(s.loop_closing.scans == false);
   CHECK(s.warnings.empty());
   CHECK_THAT(error_of(tmp.write("l1.yaml", "%YAML:1.0\nLoopClosing.Enabled: 2\n")),
              Contains("'LoopClosing.Enabled': expected 0 (off) or 1 (on)"));

@@ -29,7 +29,7 @@
 //   Tracking.RegisterLost (0/1, TrackerOptions::register_lost: a lost frame placed by its scan),
 //   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
 //   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1), MergeMaps (0/1) (LoopClosingOptions' fields of those
-//   names), LocalMapping.PlaceCulling (0/1), LocalMapping.LidarPairSigma (m, 0 = off, default 0.02:
+//   names), LoopClosing.Scans (0/1, LoopScanOptions::enabled: the loop measured again by the scans), LocalMapping.PlaceCulling (0/1), LocalMapping.LidarPairSigma (m, 0 = off, default 0.02:
 //   KeyframePairOptions::lidar_sigma_translation, keyframes tied by their scans' registration),
 //   LocalMapping.LidarPairSigmaRotation (rad: that pair's lidar_sigma_rotation),
 //   LocalMapping.LidarPairAgreeingSigma (m, 0 = as LidarPairSigma: lidar_agreeing_sigma_translation).
@@ -73,6 +73,7 @@ struct LoopClosingSettings {
   std::optional<bool> fuse;
   std::optional<bool> global_ba;
   std::optional<bool> merge_maps;
+  std::optional<bool> scans;              // LoopClosing.Scans (0/1)
   std::optional<bool> bridge;             // LoopClosing.BridgeGaps (0/1)
   std::optional<double> bridge_max_gap_s;  // LoopClosing.BridgeMaxGap, seconds
 

@@ -39,6 +39,7 @@
 #include <memory>
 #include <string>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 namespace rgbl {
@@ -51,6 +52,27 @@ struct MapBridgeOptions {
   // What the guess over the gap can be off, how far the registration searches, and what it must
   // pass to move the new map (a clear, pinned-down optimum within that reach).
   GapRegistrationOptions registration;
+
+  void validate() const;
+};
+
+// A loop's relative poses measured again by the LiDAR: the images' verification leans on the matched
+// place's landmarks, whose own errors (made when the map was young, seen from far) can put a short
+// loop's measurement further off than the map has drifted (docs/loop-closing.md, "Loops measured by
+// the scans"); the two keyframes' scans, registered from it, do not share those errors.
+struct LoopScanOptions {
+  bool enabled = true;
+  // Every keyframe keeps its scan as one point per voxel of this edge (the registration's reference
+  // voxel, so a stored reference registers as the full scan would): ~15k points, 0.25 MB, on KITTI.
+  double voxel = 0.5;  // m
+  // The registration must converge from the images' measurement, be a clear optimum (moved by 1 m
+  // along any axis it loses at least min_probe_loss of its landing points, as the gap registration
+  // asks) and stay within max_change of the images' measurement: ICP's coarse correspondences reach
+  // 1.5 m, and a result beyond this is another optimum, not a refinement.
+  double min_probe_loss = 0.1;
+  double max_change_m = 1.0;
+  double max_change_deg = 3.0;
+  ScanRegistrationOptions registration;
 
   void validate() const;
 };
@@ -102,6 +124,7 @@ struct LoopClosingOptions {
   // joins the two; the same checks as a loop decide.
   bool merge_maps = true;
   MapBridgeOptions bridge;  // merging across a gap the drive never returns to (needs merge_maps)
+  LoopScanOptions scans;    // the loop's relative poses refined by the keyframes' scans (needs the LiDAR)
   LoopVerificationOptions verification;
   LoopCorrectionOptions correction;
   // Fusion across the loop: the landmarks of the matched keyframe and its fusion_neighbours best
@@ -177,6 +200,8 @@ struct LoopClosingStats {
   int merges = 0;       // of those, closures that joined two maps
   int bridge_attempts = 0;  // new maps whose first scan was registered onto the map before
   int bridges = 0;          // of the merges, those by such a registration
+  int scan_refined = 0;     // loop constraints (of consistent loops) the scans measured again...
+  int scan_kept = 0;        // ...and those the scans could not (the images' measurement kept)
   double time_ms = 0.0; // detection, verification and correction over the run (threaded: off the tracking path)
 };
 
@@ -216,6 +241,13 @@ class LoopCloser {
   PinholeCamera camera_;
   std::optional<Eigen::Isometry3d> T_cam_lidar_;  // none: no bridging
   std::shared_ptr<TaskPool> pool_;
+  // Each keyframe's scan, voxel-downsampled (LoopScanOptions), by keyframe id; dropped with the keyframe.
+  std::unordered_map<int, std::vector<LidarPoint>> scans_;
+  // The constraint re-measured by the scans of its two keyframes (`current_scan` for the current one
+  // when given), or nullopt when they cannot (LoopScanOptions' checks).
+  std::optional<LoopConstraint> scan_refined(const LoopConstraint& c, PointCloudView current_scan) const;
+  // Keeps this keyframe's scan and drops those of keyframes no longer in the map.
+  void keep_scan(const Map& map, KeyframeId keyframe, PointCloudView scan);
   LoopClosingOptions options_;
   std::vector<std::unique_ptr<PlaceRecognizer>> places_;
   std::vector<LoopConstraint> loops_;
