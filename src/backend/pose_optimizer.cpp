@@ -15,11 +15,10 @@ void PoseOptimizerOptions::validate() const {
   require(chi2_2d > 0.0 && chi2_3d > 0.0, "pose_optimizer.chi2", "> 0");
 }
 
-void PoseMotionPrior::validate() const {
-  require(std::abs(direction_cam.norm() - 1.0) < 1e-6, "pose_motion_prior.direction_cam", "a unit vector");
-  require(std::isfinite(sigma_floor_m) && sigma_floor_m > 0.0, "pose_motion_prior.sigma_floor_m", "> 0");
-  require(std::isfinite(sigma_per_m) && sigma_per_m >= 0.0, "pose_motion_prior.sigma_per_m", ">= 0");
-  require(std::isfinite(lever_m) && lever_m >= 0.0, "pose_motion_prior.lever_m", ">= 0");
+void MotionPriorSigmas::validate() const {
+  require(std::isfinite(floor_m) && floor_m > 0.0, "motion_prior.floor_m", "> 0 m");
+  require(std::isfinite(per_m) && per_m >= 0.0, "motion_prior.per_m", ">= 0");
+  require(std::isfinite(lever_m) && lever_m >= 0.0, "motion_prior.lever_m", ">= 0 m");
 }
 
 namespace {
@@ -53,7 +52,8 @@ void motion_prior_residual(const PoseMotionPrior& prior, const Eigen::Isometry3d
   const Eigen::Vector3d e1 = d.cross(a).normalized();
   const Eigen::Vector3d e2 = d.cross(e1);
   const Eigen::Vector3d step = T_cam_world.inverse().translation() - prior.T_last_world.inverse().translation();
-  const double sigma = prior.sigma_floor_m + prior.sigma_per_m * std::abs(d.dot(step)) + prior.lever_m * turn;
+  const MotionPriorSigmas& s = prior.sigmas;
+  const double sigma = s.floor_m + s.per_m * std::abs(d.dot(step)) + s.lever_m * turn;
   residual << e1.dot(step) / sigma, e2.dot(step) / sigma;
   // the centre c = -R^T t moves by -R^T rho under T <- exp([rho; phi]) T (to first order)
   const Eigen::Matrix3d dc_drho = -T_cam_world.linear().transpose();

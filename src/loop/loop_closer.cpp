@@ -330,10 +330,8 @@ void LoopCloser::keep_scan(const Map& map, KeyframeId keyframe, PointCloudView s
 
 std::optional<LoopConstraint> LoopCloser::scan_refined(const LoopConstraint& c, PointCloudView current_scan) const {
   const auto matched = scans_.find(c.matched.value);
-  const auto current = scans_.find(c.current.value);
-  const PointCloudView query = !current_scan.empty() ? current_scan
-                               : current != scans_.end() ? PointCloudView(current->second)
-                                                         : PointCloudView{};
+  PointCloudView query = current_scan;
+  if (const auto current = scans_.find(c.current.value); query.empty() && current != scans_.end()) query = current->second;
   if (matched == scans_.end() || query.empty()) return std::nullopt;
   const Eigen::Isometry3d& T_cam_lidar = *T_cam_lidar_;
   // the images' measurement between the two LiDAR frames: matched <- current

@@ -28,11 +28,7 @@ void TrackerOptions::validate() const {
   gap_registration.validate();
   require(std::isfinite(lidar_start_max_speed) && lidar_start_max_speed >= 0.0, "tracker.lidar_start_max_speed",
           ">= 0 m/s (0 = off)");
-  require(std::isfinite(direction_prior_floor_m) && direction_prior_floor_m > 0.0, "tracker.direction_prior_floor_m",
-          "> 0 m");
-  require(std::isfinite(direction_prior_per_m) && direction_prior_per_m >= 0.0, "tracker.direction_prior_per_m", ">= 0");
-  require(std::isfinite(direction_prior_lever_m) && direction_prior_lever_m >= 0.0, "tracker.direction_prior_lever_m",
-          ">= 0 m");
+  direction_prior_sigmas.validate();
   require(std::isfinite(direction_min_step_m) && direction_min_step_m > 0.0, "tracker.direction_min_step_m", "> 0 m");
   require(std::isfinite(direction_learned_m) && direction_learned_m >= 0.0, "tracker.direction_learned_m", ">= 0 m");
   require(min_initial_depth_points >= 10, "tracker.min_initial_depth_points", ">= 10");

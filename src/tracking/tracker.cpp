@@ -709,9 +709,7 @@ std::optional<PoseMotionPrior> Tracker::motion_prior() const {
   PoseMotionPrior prior;
   prior.T_last_world = last_frame_->T_cam_world;
   prior.direction_cam = *direction;
-  prior.sigma_floor_m = options_.direction_prior_floor_m;
-  prior.sigma_per_m = options_.direction_prior_per_m;
-  prior.lever_m = options_.direction_prior_lever_m;
+  prior.sigmas = options_.direction_prior_sigmas;
   return prior;
 }
 

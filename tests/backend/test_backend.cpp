@@ -308,7 +308,7 @@ TEST_CASE("pose motion prior: the step across the direction of travel, in sigmas
   rgbl::PoseMotionPrior prior;
   prior.T_last_world = T_last;
   prior.direction_cam = Eigen::Vector3d(0.02, 0.01, 1.0).normalized();  // a mount slightly yawed and pitched
-  REQUIRE_NOTHROW(prior.validate());
+  REQUIRE_NOTHROW(prior.sigmas.validate());
   // a camera centre 2 m along the direction from the last one, then moved across it
   const auto moved = [&](const Eigen::Vector3d& offset_cam) {
     Eigen::Isometry3d T = T_last;
@@ -348,8 +348,8 @@ TEST_CASE("pose motion prior: the step across the direction of travel, in sigmas
   rgbl::motion_prior_residual(prior, T_arc, r, J);
   CHECK(r.norm() == Approx(0.05 / (0.08 + 2.0 * turn)).epsilon(1e-9));
 
-  prior.sigma_floor_m = 0.0;
-  CHECK_THROWS_AS(prior.validate(), rgbl::ConfigError);
+  prior.sigmas.floor_m = 0.0;
+  CHECK_THROWS_AS(prior.sigmas.validate(), rgbl::ConfigError);
 }
 
 TEST_CASE("pose optimisation with a motion prior: matches that err together pull the pose less across the direction of travel") {

@@ -159,8 +159,9 @@ TEST_CASE("frame threads: a raw drive's LiDAR depth finished on the tracking thr
 }
 
 namespace {
-// Sequence 04's frames 0-7 and 28-33 as one sequence in `dir`: 2.1 s between its 8th and 9th frames.
-std::filesystem::path write_gap_excerpt(const rgbl::test::TempDir& dir, const std::filesystem::path& sequence) {
+// Sequence 04's frames 0-7 and 28-33 as one sequence in `dir` (2.1 s between its 8th and 9th frames),
+// run on 2 frame threads.
+rgbl::PipelineOptions gap_excerpt(const rgbl::test::TempDir& dir, const std::filesystem::path& sequence) {
   const auto folder = dir.path() / "sequences" / "04";
   std::filesystem::create_directories(folder / "image_0");
   std::filesystem::create_directories(folder / "velodyne");
@@ -177,7 +178,10 @@ std::filesystem::path write_gap_excerpt(const rgbl::test::TempDir& dir, const st
     kept_times += times.at(static_cast<std::size_t>(i)) + "\n";
   }
   dir.write("sequences/04/times.txt", kept_times);
-  return folder;
+  rgbl::PipelineOptions o;
+  o.dataset = folder;
+  o.threads = 2;
+  return o;
 }
 }  // namespace
 
@@ -186,9 +190,7 @@ TEST_CASE("frame threads: a gap registered on the frame pool, the same poses as 
   const auto sequence = rgbl::test::kitti_seq04();
   if (!sequence) return;
   const rgbl::test::TempDir dir;
-  rgbl::PipelineOptions o;
-  o.dataset = write_gap_excerpt(dir, *sequence);
-  o.threads = 2;
+  const rgbl::PipelineOptions o = gap_excerpt(dir, *sequence);
   const rgbl::RunResult run = rgbl::Pipeline(o).run();
   REQUIRE(run.frames.size() == 14);
   CHECK(run.frames[8].result.gap);
@@ -202,10 +204,8 @@ TEST_CASE("frame threads: two maps bridged on the frame pool, the same poses as 
   const auto sequence = rgbl::test::kitti_seq04();
   if (!sequence) return;
   const rgbl::test::TempDir dir;
-  rgbl::PipelineOptions o;
-  o.dataset = write_gap_excerpt(dir, *sequence);
+  rgbl::PipelineOptions o = gap_excerpt(dir, *sequence);
   o.settings = dir.write("nogaps.yaml", "%YAML:1.0\nTracking.RegisterGaps: 0\n");
-  o.threads = 2;
   const rgbl::RunResult run = rgbl::Pipeline(o).run();
   REQUIRE(run.frames.size() == 14);
   CHECK(run.frames[8].result.state == rgbl::TrackState::Lost);

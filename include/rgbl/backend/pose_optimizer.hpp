@@ -52,15 +52,19 @@ struct PoseOptimizerOptions {
 // or on a change of slope, and in a turn by the camera's lever ahead of the rear axle. A soft prior on
 // the step across that direction, none along it (braking, gaps and standing still stay free): crossing
 // traffic or a group of matches on a vehicle can pull a pose sideways or up, which no car does.
+// Across the direction, sigma = floor_m + per_m * |step along| + lever_m * turn (rad).
+struct MotionPriorSigmas {
+  double floor_m = 0.01;  // the body's sway: roll or pitch of ~0.5 deg at 1-1.5 m above the axle
+  double per_m = 0.035;   // 2 deg: pitch under braking or on a crest, and the direction's own error
+  double lever_m = 2.0;   // a camera up to 2 m ahead of the rear axle slides out by that times the turn
+
+  void validate() const;
+};
+
 struct PoseMotionPrior {
   Eigen::Isometry3d T_last_world = Eigen::Isometry3d::Identity();  // the previous frame's pose
   Eigen::Vector3d direction_cam = Eigen::Vector3d::UnitZ();  // unit; in the camera frame half-way through the turn
-  // Across the direction, sigma = sigma_floor_m + sigma_per_m * |step along| + lever_m * turn (rad).
-  double sigma_floor_m = 0.01;  // the body's sway: roll or pitch of ~0.5 deg at 1-1.5 m above the axle
-  double sigma_per_m = 0.035;   // 2 deg: pitch under braking or on a crest, and the direction's own error
-  double lever_m = 2.0;         // a camera up to 2 m ahead of the rear axle slides out by that times the turn
-
-  void validate() const;
+  MotionPriorSigmas sigmas;
 };
 
 // The step from T_last_world's camera centre to T_cur_world's, in the camera frame turned half-way

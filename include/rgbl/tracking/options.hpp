@@ -137,13 +137,10 @@ struct TrackerOptions {
   bool check_steps = true;
   // A car moves along its heading: while the last frame was tracked, every pose optimisation but a
   // relocalisation's holds the step across the learned direction of travel (TravelDirection) with
-  // PoseMotionPrior's sigma (direction_prior_floor_m + direction_prior_per_m * |step along| +
-  // direction_prior_lever_m * turn); nothing along it. Learned from tracked steps of at least
+  // direction_prior_sigmas; nothing along it. Learned from tracked steps of at least
   // direction_min_step_m, used once direction_learned_m of them were seen.
   bool direction_prior = true;
-  double direction_prior_floor_m = 0.01;
-  double direction_prior_per_m = 0.035;
-  double direction_prior_lever_m = 2.0;
+  MotionPriorSigmas direction_prior_sigmas;
   double direction_min_step_m = 0.2;
   double direction_learned_m = 3.0;
   double step_tolerance = 0.25;            // m
