@@ -51,7 +51,7 @@ MapBundle make_map_bundle(const Map& map, std::span<const KeyframeId> window, st
       o.sigma_px = std::pow(scale, kf->keypoints[ks].level);
       if (kf->depth_sigma[ks] > 0.0F) {
         o.depth = kf->depth[ks];
-        o.depth_sigma = kf->depth_sigma[ks];
+        o.depth_sigma = kf->depth_sigma[ks] * landmark->depth_sigma_scale;
       }
       bundle.problem.observations.push_back(o);
       bundle.observations.emplace_back(l, k);

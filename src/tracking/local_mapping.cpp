@@ -5,6 +5,7 @@
 #include "rgbl/core/timer.hpp"
 #include "rgbl/geometry/scan_registration.hpp"
 #include "rgbl/geometry/se3.hpp"
+#include "rgbl/map/depth_consistency.hpp"
 #include "rgbl/map/fusion.hpp"
 
 #include <algorithm>
@@ -238,6 +239,11 @@ int LocalMapper::local_bundle_adjustment(KeyframeId id, double& elapsed_ms) {
   {
     std::unique_lock lock(map_.mutex());
     outliers = apply_map_bundle(map_, bundle, result);
+    if (options_.depth_consistency) {
+      for (const LandmarkId adjusted : bundle.landmarks) {
+        if (Landmark* l = map_.landmark(adjusted)) l->depth_sigma_scale = depth_consistency_scale(map_, *l, camera_);
+      }
+    }
   }
   elapsed_ms = watch.elapsed_ms();
   return outliers;

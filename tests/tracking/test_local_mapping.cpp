@@ -4,11 +4,13 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -289,4 +291,99 @@ TEST_CASE("local mapping checks the LiDAR pair's options (naming the field)") {
   o = {};
   o.lidar_registration.fine_distance = -1.0;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("fine_distance"));
+}
+
+namespace {
+
+// Five keyframes 0.5 m apart (2 m of baseline) see 200 points 6-14 m ahead. The points right of x =
+// 1.5 m are a hedge: each keyframe's depth there is 0.2-0.4 m deep (a different depth each time, as
+// leaves return a beam), the others' exact; sigmas 0.05 m. Every landmark starts where its first
+// keyframe's depth puts it; local mapping runs twice on the last keyframe (the second BA uses the
+// sigmas the first one's landmarks left). Returns the mean landmark error and how many had their
+// depth sigmas scaled, of the hedge within 9 m (where 2 m of baseline measure depth to 0.1 m) and of
+// the other points.
+struct HedgeMapping {
+  double hedge_error = 0.0, other_error = 0.0;
+  int hedge = 0, other = 0, hedge_scaled = 0, other_scaled = 0;
+};
+HedgeMapping map_hedge(bool depth_consistency) {
+  rgbl::test::PointsMap s = rgbl::test::make_points_map(5, 200, 3);
+  const auto in_hedge = [&](std::size_t i) { return s.points[i].x() > 1.5; };
+  const auto near_hedge = [&](std::size_t i) { return in_hedge(i) && s.points[i].z() < 9.0; };
+  rgbl::Map map;
+  std::vector<rgbl::LandmarkId> landmark(s.points.size());
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> leaves(0.2, 0.4);
+  for (std::size_t k = 0; k < s.T_cam_world.size(); ++k) {
+    rgbl::Keyframe kf = rgbl::test::make_points_keyframe(s, static_cast<int>(k), s.T_cam_world[k]);
+    for (std::size_t i = 0; i < s.points.size(); ++i) {
+      const int keypoint = s.keypoint_of_point[k][i];
+      if (keypoint >= 0 && in_hedge(i)) kf.depth[static_cast<std::size_t>(keypoint)] += static_cast<float>(leaves(rng));
+    }
+    const rgbl::KeyframeId id = map.add_keyframe(std::move(kf));
+    for (std::size_t i = 0; i < s.points.size(); ++i) {
+      const int keypoint = s.keypoint_of_point[k][i];
+      if (keypoint < 0) continue;
+      if (!landmark[i].valid()) {
+        const rgbl::Keyframe& first = *map.keyframe(id);
+        const auto kp = static_cast<std::size_t>(keypoint);
+        const Eigen::Vector3d p_cam =
+            s.camera.unproject(Eigen::Vector2d(first.keypoints[kp].x, first.keypoints[kp].y), first.depth[kp]);
+        landmark[i] = map.add_landmark(first.T_cam_world.inverse() * p_cam, id);
+      }
+      map.keyframe(id)->landmarks[static_cast<std::size_t>(keypoint)] = landmark[i];
+      map.add_observation(landmark[i], id, keypoint);
+    }
+    map.update_covisibility(id);
+  }
+  for (const rgbl::LandmarkId l : landmark) {
+    if (l.valid()) map.update_landmark(l);
+  }
+  rgbl::LocalMappingOptions options;
+  options.fusion = false;
+  options.keyframe_culling = false;
+  options.max_new_depth_points = 0;
+  options.pairs.lidar_sigma_translation = 0.0;
+  options.depth_consistency = depth_consistency;
+  rgbl::LocalMapper mapper(map, s.camera, options);
+  mapper.process(map.last_keyframe_id());
+  mapper.process(map.last_keyframe_id());
+  HedgeMapping out;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    const rgbl::Landmark* l = landmark[i].valid() ? map.landmark(landmark[i]) : nullptr;
+    if (l == nullptr || l->observations.size() < 3) continue;
+    const double error = (l->position - s.points[i]).norm();
+    const bool scaled = l->depth_sigma_scale > 1.0;
+    if (near_hedge(i)) {
+      out.hedge_error += error;
+      ++out.hedge;
+      out.hedge_scaled += scaled ? 1 : 0;
+    } else if (!in_hedge(i)) {
+      out.other_error += error;
+      ++out.other;
+      out.other_scaled += scaled ? 1 : 0;
+    }
+  }
+  out.hedge_error /= std::max(out.hedge, 1);
+  out.other_error /= std::max(out.other, 1);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("local mapping weighs a hedge's depths by how far they disagree with its parallax") {
+  const HedgeMapping off = map_hedge(false);
+  const HedgeMapping on = map_hedge(true);
+  REQUIRE(on.hedge >= 10);
+  REQUIRE(on.other >= 100);
+  INFO("hedge " << off.hedge_error << " -> " << on.hedge_error << " m, others " << off.other_error << " -> "
+                << on.other_error << " m; scaled " << on.hedge_scaled << " of " << on.hedge << " and "
+                << on.other_scaled << " of " << on.other);
+  CHECK(off.hedge_scaled == 0);  // off: every sigma as measured
+  // 0.2-0.4 m deep at 6-14 m against 0.05 m sigmas and 2 m of baseline: most of the hedge is caught
+  CHECK(on.hedge_scaled >= 0.8 * on.hedge);
+  CHECK(on.other_scaled <= 0.1 * on.other);
+  // and its landmarks follow the images: nearer the truth than where the depths hold them
+  CHECK(on.hedge_error < 0.6 * off.hedge_error);
+  CHECK(on.other_error <= 1.1 * off.other_error);
 }

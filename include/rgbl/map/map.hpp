@@ -82,6 +82,10 @@ struct Landmark {
   KeyframeId first_keyframe;
   int visible = 1;  // frames in which it was predicted visible
   int found = 1;    // frames in which it was matched
+  // How far its keyframes' depths disagree with their parallax beyond their sigmas (>= 1; set by local
+  // mapping, LocalMappingOptions::depth_consistency): every depth row of this landmark in bundle
+  // adjustment is weighed by its sigma times this (the tracker's rows are not: see docs/accuracy.md).
+  double depth_sigma_scale = 1.0;
 
   double found_ratio() const { return static_cast<double>(found) / visible; }
   // Pyramid level at which a keypoint of this landmark should appear at `distance`.

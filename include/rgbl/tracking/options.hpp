@@ -263,6 +263,9 @@ struct LocalMappingOptions {
   double place_distance_ratio = 0.1;
   double place_angle_deg = 10.0;
   double revisit_path_ratio = 3.0;
+  // After each local BA, every adjusted landmark's depth sigmas scaled by how far its depths disagree
+  // with its keyframes' parallax (depth_consistency_scale, map/depth_consistency.hpp).
+  bool depth_consistency = false;
   bool local_ba = true;
   bool keyframe_culling = true;
   bool fusion = true;
