@@ -424,6 +424,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.direction_prior = flag("Tracking.DirectionPrior");
   s.register_gaps = flag("Tracking.RegisterGaps");
   s.register_lost = flag("Tracking.RegisterLost");
+  s.depth_consistency = flag("LocalMapping.DepthConsistency");
 
   if (!(s.projection.min_depth >= 0.0F)) r.fail("LiDAR.min_dist", "a distance >= 0 m");
   if (!(s.projection.max_depth > s.projection.min_depth))

@@ -266,11 +266,12 @@ TEST_CASE("settings: the LiDAR pair's sigmas and the scan samples' elevation cor
   }
 }
 
-TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, RegisterGaps, CauchyWeights, ObjectTest and DirectionPrior, read and validated", "[io][settings]") {
+TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, RegisterGaps, CauchyWeights, ObjectTest, DirectionPrior and LocalMapping.DepthConsistency, read and validated", "[io][settings]") {
   rgbl::test::TempDir tmp;
   const auto s = rgbl::read_settings(tmp.write(
       "t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0.25\nTracking.BoundedDepthError: 1\nTracking.RegisterGaps: 0\n"
-                "Tracking.CauchyWeights: 0\nTracking.ObjectTest: 1\nTracking.DirectionPrior: 0\n"));
+                "Tracking.CauchyWeights: 0\nTracking.ObjectTest: 1\nTracking.DirectionPrior: 0\n"
+                "LocalMapping.DepthConsistency: 1\n"));
   REQUIRE(s.reference_landmark_ratio);
   CHECK(*s.reference_landmark_ratio == 0.25);
   CHECK(s.bounded_depth_error == true);
@@ -278,6 +279,7 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK(s.cauchy_weights == false);
   CHECK(s.object_test == true);
   CHECK(s.direction_prior == false);
+  CHECK(s.depth_consistency == true);
   CHECK(s.warnings.empty());
   const auto unset = rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n"));
   CHECK_FALSE(unset.reference_landmark_ratio);
@@ -286,6 +288,7 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK_FALSE(unset.cauchy_weights);
   CHECK_FALSE(unset.object_test);
   CHECK_FALSE(unset.direction_prior);
+  CHECK_FALSE(unset.depth_consistency);
   CHECK_THAT(error_of(tmp.write("gaps.yaml", "%YAML:1.0\nTracking.RegisterGaps: yes\n")),
              Contains("'Tracking.RegisterGaps'"));
   CHECK_THAT(error_of(tmp.write("ratio.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 1.5\n")),
@@ -298,6 +301,8 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
              Contains("'Tracking.CauchyWeights': expected 0 (off) or 1 (on)"));
   CHECK_THAT(error_of(tmp.write("direction.yaml", "%YAML:1.0\nTracking.DirectionPrior: 2\n")),
              Contains("'Tracking.DirectionPrior': expected 0 (off) or 1 (on)"));
+  CHECK_THAT(error_of(tmp.write("consistency.yaml", "%YAML:1.0\nLocalMapping.DepthConsistency: 2\n")),
+             Contains("'LocalMapping.DepthConsistency': expected 0 (off) or 1 (on)"));
 }
 
 TEST_CASE("settings: wrong types, incomplete groups and bad values name file and key", "[io][settings][bad-input]") {

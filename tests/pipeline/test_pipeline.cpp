@@ -203,6 +203,9 @@ TEST_CASE("the settings file's Tracking keys reach the tracker") {
   CHECK_FALSE(set.register_gaps);
   CHECK_FALSE(set.pose.cauchy);
   CHECK(set.object_test);
+  CHECK_FALSE(rgbl::Pipeline(o).system_options().mapping.depth_consistency);
+  o.settings = dir.write("m.yaml", "%YAML:1.0\nLocalMapping.DepthConsistency: 1\n");
+  CHECK(rgbl::Pipeline(o).system_options().mapping.depth_consistency);
 }
 
 TEST_CASE("the settings file's LiDAR pair sigmas and elevation correction reach local mapping and the scan samples") {

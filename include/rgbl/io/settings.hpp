@@ -27,6 +27,8 @@
 //   direction of travel, default 1),
 //   Tracking.RegisterGaps (0/1, TrackerOptions::register_gaps: the scans registered across a gap),
 //   Tracking.RegisterLost (0/1, TrackerOptions::register_lost: a lost frame placed by its scan),
+//   LocalMapping.DepthConsistency (0/1, LocalMappingOptions::depth_consistency: a landmark's depth
+//   sigmas scaled by how far its depths disagree with its keyframes' parallax),
 //   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
 //   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1), MergeMaps (0/1) (LoopClosingOptions' fields of those
 //   names), LoopClosing.Scans (0/1, LoopScanOptions::enabled: the loop measured again by the scans), LocalMapping.PlaceCulling (0/1), LocalMapping.LidarPairSigma (m, 0 = off, default 0.02:
@@ -118,6 +120,7 @@ struct Settings {
   std::optional<bool> direction_prior;              // Tracking.DirectionPrior
   std::optional<bool> register_gaps;                // Tracking.RegisterGaps
   std::optional<bool> register_lost;                // Tracking.RegisterLost
+  std::optional<bool> depth_consistency;            // LocalMapping.DepthConsistency
   std::vector<std::string> warnings;  // unknown keys, one message each
 };
 
