@@ -240,9 +240,15 @@ int LocalMapper::local_bundle_adjustment(KeyframeId id, double& elapsed_ms) {
     std::unique_lock lock(map_.mutex());
     outliers = apply_map_bundle(map_, bundle, result);
     if (options_.depth_consistency) {
+      int scaled = 0;
       for (const LandmarkId adjusted : bundle.landmarks) {
-        if (Landmark* l = map_.landmark(adjusted)) l->depth_sigma_scale = depth_consistency_scale(map_, *l, camera_);
+        if (Landmark* l = map_.landmark(adjusted)) {
+          l->depth_sigma_scale = depth_consistency_scale(map_, *l, camera_);
+          scaled += l->depth_sigma_scale > 1.0 ? 1 : 0;
+        }
       }
+      logger()->debug("keyframe {}: {} of {} landmarks' depths disagree with their parallax", id.value, scaled,
+                      bundle.landmarks.size());
     }
   }
   elapsed_ms = watch.elapsed_ms();
