@@ -425,6 +425,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.register_gaps = flag("Tracking.RegisterGaps");
   s.register_lost = flag("Tracking.RegisterLost");
   s.depth_consistency = flag("LocalMapping.DepthConsistency");
+  s.triangulation = flag("LocalMapping.Triangulation");
 
   if (!(s.projection.min_depth >= 0.0F)) r.fail("LiDAR.min_dist", "a distance >= 0 m");
   if (!(s.projection.max_depth > s.projection.min_depth))

@@ -101,6 +101,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.register_gaps) p.system.tracker.register_gaps = *s.register_gaps;
   if (s.register_lost) p.system.tracker.register_lost = *s.register_lost;
   if (s.depth_consistency) p.system.mapping.depth_consistency = *s.depth_consistency;
+  if (s.triangulation) p.system.mapping.triangulation = *s.triangulation;
   if (s.bf || s.th_depth) {
     p.notes.push_back("Camera.bf / ThDepth are not used: rgbl weights depth with an explicit noise model");
   }

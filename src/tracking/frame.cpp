@@ -106,6 +106,8 @@ void LocalMappingOptions::validate() const {
   require(max_keyframes_per_place >= 2, "local_mapping.max_keyframes_per_place",
           ">= 2 (the place's first keyframe and the new one)");
   fusion_match.validate();
+  triangulation_match.validate();
+  require(triangulation_min_views >= 2, "local_mapping.triangulation_min_views", ">= 2 (the two views it was made from)");
   ba.validate();
   lidar_registration.validate();
   require(lidar_min_probe_loss >= 0.0 && lidar_min_probe_loss < 1.0, "local_mapping.lidar_min_probe_loss", "in [0, 1)");

@@ -101,12 +101,14 @@ void FrameBuilder::sample_depth(PreparedFrame& out) {
   depth_->sample(pixels_, depths_);
   frame.depth.resize(n);
   frame.depth_sigma.resize(n);
+  frame.depth_refused.assign(n, false);
   out.keypoints_with_depth = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const KeypointDepth& d = depths_[i];
     const double sigma = d.z > 0.0F ? noise_.sigma(d.z, d.sample_distance_px, d.spread, calibration_.camera.fx, d.gradient) : 0.0;
     frame.depth[i] = sigma > 0.0 ? d.z : 0.0F;
     frame.depth_sigma[i] = static_cast<float>(sigma);
+    frame.depth_refused[i] = d.z > 0.0F && !(sigma > 0.0);
     out.keypoints_with_depth += sigma > 0.0 ? 1 : 0;
   }
 }

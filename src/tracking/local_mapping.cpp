@@ -7,6 +7,7 @@
 #include "rgbl/geometry/se3.hpp"
 #include "rgbl/map/depth_consistency.hpp"
 #include "rgbl/map/fusion.hpp"
+#include "rgbl/map/triangulation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -37,7 +38,30 @@ LocalMappingStats LocalMapper::process(KeyframeId keyframe, const std::vector<La
     const std::vector<LandmarkId> created = create_depth_landmarks(map_, camera_, keyframe, std::max(budget, 0));
     for (const LandmarkId l : created) recent_landmarks_.push_back({l, false});
     stats.new_landmarks = static_cast<int>(created_with_keyframe.size() + created.size());
+    std::vector<LandmarkId> triangulated;
+    if (options_.triangulation) {
+      Stopwatch watch;
+      triangulated = triangulate_landmarks(map_, camera_, keyframe, options_.triangulation_match);
+      for (const LandmarkId l : triangulated) recent_landmarks_.push_back({l, false});
+      stats.triangulated_landmarks = static_cast<int>(triangulated.size());
+      logger()->debug("keyframe {}: {} landmarks triangulated ({:.1f} ms)", keyframe.value, triangulated.size(),
+                      watch.elapsed_ms());
+    }
     if (options_.fusion) stats.fused_landmarks = fuse(keyframe);
+    if (options_.triangulation && options_.triangulation_min_views > 2) {
+      // two views agree on any pair along an epipolar line through repeated texture; a third view at
+      // the predicted place (found by the fusion just run) is what tells a point from a coincidence
+      int unconfirmed = 0;
+      for (const LandmarkId l : triangulated) {
+        const Landmark* landmark = map_.landmark(l);
+        if (landmark != nullptr && std::cmp_less(landmark->observations.size(), options_.triangulation_min_views)) {
+          map_.erase_landmark(l);
+          ++unconfirmed;
+        }
+      }
+      stats.triangulated_landmarks -= unconfirmed;
+      logger()->debug("keyframe {}: {} triangulated landmarks not seen in a third keyframe", keyframe.value, unconfirmed);
+    }
   }
   if (options_.pairs.lidar_sigma_translation > 0.0) {
     measure_lidar_pair(keyframe);

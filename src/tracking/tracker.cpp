@@ -32,6 +32,7 @@ Keyframe keyframe_from(const Frame& frame, const TrackerOptions& options) {
   kf.descriptors = frame.descriptors;
   kf.depth = frame.depth;
   kf.depth_sigma = frame.depth_sigma;
+  kf.depth_refused = frame.depth_refused;
   if (frame.scan_at_image_time) kf.scan = frame.scan;
   // the road under it, which ties it to the keyframes before it in local BA
   if (frame.scan) {

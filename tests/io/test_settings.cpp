@@ -266,12 +266,12 @@ TEST_CASE("settings: the LiDAR pair's sigmas and the scan samples' elevation cor
   }
 }
 
-TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, RegisterGaps, CauchyWeights, ObjectTest, DirectionPrior and LocalMapping.DepthConsistency, read and validated", "[io][settings]") {
+TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, RegisterGaps, CauchyWeights, ObjectTest, DirectionPrior, LocalMapping.DepthConsistency and Triangulation, read and validated", "[io][settings]") {
   rgbl::test::TempDir tmp;
   const auto s = rgbl::read_settings(tmp.write(
       "t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0.25\nTracking.BoundedDepthError: 1\nTracking.RegisterGaps: 0\n"
                 "Tracking.CauchyWeights: 0\nTracking.ObjectTest: 1\nTracking.DirectionPrior: 0\n"
-                "LocalMapping.DepthConsistency: 1\n"));
+                "LocalMapping.DepthConsistency: 1\nLocalMapping.Triangulation: 1\n"));
   REQUIRE(s.reference_landmark_ratio);
   CHECK(*s.reference_landmark_ratio == 0.25);
   CHECK(s.bounded_depth_error == true);
@@ -280,6 +280,7 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK(s.object_test == true);
   CHECK(s.direction_prior == false);
   CHECK(s.depth_consistency == true);
+  CHECK(s.triangulation == true);
   CHECK(s.warnings.empty());
   const auto unset = rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n"));
   CHECK_FALSE(unset.reference_landmark_ratio);
@@ -289,6 +290,9 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK_FALSE(unset.object_test);
   CHECK_FALSE(unset.direction_prior);
   CHECK_FALSE(unset.depth_consistency);
+  CHECK_FALSE(unset.triangulation);
+  CHECK_THAT(error_of(tmp.write("tri.yaml", "%YAML:1.0\nLocalMapping.Triangulation: 2\n")),
+             Contains("'LocalMapping.Triangulation'"));
   CHECK_THAT(error_of(tmp.write("gaps.yaml", "%YAML:1.0\nTracking.RegisterGaps: yes\n")),
              Contains("'Tracking.RegisterGaps'"));
   CHECK_THAT(error_of(tmp.write("ratio.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 1.5\n")),

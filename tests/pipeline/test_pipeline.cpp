@@ -204,8 +204,10 @@ TEST_CASE("the settings file's Tracking keys reach the tracker") {
   CHECK_FALSE(set.pose.cauchy);
   CHECK(set.object_test);
   CHECK_FALSE(rgbl::Pipeline(o).system_options().mapping.depth_consistency);
-  o.settings = dir.write("m.yaml", "%YAML:1.0\nLocalMapping.DepthConsistency: 1\n");
+  CHECK_FALSE(rgbl::Pipeline(o).system_options().mapping.triangulation);
+  o.settings = dir.write("m.yaml", "%YAML:1.0\nLocalMapping.DepthConsistency: 1\nLocalMapping.Triangulation: 1\n");
   CHECK(rgbl::Pipeline(o).system_options().mapping.depth_consistency);
+  CHECK(rgbl::Pipeline(o).system_options().mapping.triangulation);
 }
 
 TEST_CASE("the settings file's LiDAR pair sigmas and elevation correction reach local mapping and the scan samples") {

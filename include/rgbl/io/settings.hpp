@@ -29,6 +29,8 @@
 //   Tracking.RegisterLost (0/1, TrackerOptions::register_lost: a lost frame placed by its scan),
 //   LocalMapping.DepthConsistency (0/1, LocalMappingOptions::depth_consistency: a landmark's depth
 //   sigmas scaled by how far its depths disagree with its keyframes' parallax),
+//   LocalMapping.Triangulation (0/1, LocalMappingOptions::triangulation: landmarks triangulated between
+//   keyframes for keypoints without depth),
 //   rgbl's own LoopClosing.Enabled (0/1), MaxPlaceDistance, ConsistentKeyframes, MaxDriftPercent,
 //   MaxDriftDegPer100m, Fuse (0/1), GlobalBA (0/1), MergeMaps (0/1) (LoopClosingOptions' fields of those
 //   names), LoopClosing.Scans (0/1, LoopScanOptions::enabled: the loop measured again by the scans), LocalMapping.PlaceCulling (0/1), LocalMapping.LidarPairSigma (m, 0 = off, default 0.02:
@@ -121,6 +123,7 @@ struct Settings {
   std::optional<bool> register_gaps;                // Tracking.RegisterGaps
   std::optional<bool> register_lost;                // Tracking.RegisterLost
   std::optional<bool> depth_consistency;            // LocalMapping.DepthConsistency
+  std::optional<bool> triangulation;                // LocalMapping.Triangulation
   std::vector<std::string> warnings;  // unknown keys, one message each
 };
 

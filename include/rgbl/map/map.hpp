@@ -45,6 +45,10 @@ struct Keyframe {
   std::vector<Descriptor> descriptors;
   std::vector<float> depth;           // camera z per keypoint, metres; 0 = none
   std::vector<float> depth_sigma;     // standard deviation of depth, metres; 0 when depth is 0
+  // Keypoints where the depth source measured something but no usable depth (Frame::depth_refused; a
+  // depth edge): a corner there may be where two surfaces cross in the image, no point in the world,
+  // so triangulation leaves them out. Empty = none known.
+  std::vector<bool> depth_refused;
   std::vector<LandmarkId> landmarks;  // per keypoint; invalid = none
   std::map<KeyframeId, int> covisibility;  // other keyframe -> number of shared landmarks
   KeyframeId parent;                        // spanning tree; invalid for the root

@@ -37,6 +37,9 @@ struct Frame {
   std::vector<Descriptor> descriptors;
   std::vector<float> depth;        // metres, 0 = none
   std::vector<float> depth_sigma;  // metres, 0 = depth not usable
+  // The depth source had a value here that the noise model refused (a depth edge under the kernel, too
+  // uncertain): something was measured, just no single surface. Empty = none known.
+  std::vector<bool> depth_refused;
   std::vector<LandmarkId> landmarks;
   std::vector<bool> outlier;
   // Keypoints on something moving against the scene: depth-consensus outliers of the frame-to-frame

@@ -14,6 +14,7 @@ namespace rgbl {
 
 struct LocalMappingStats {
   int new_landmarks = 0;
+  int triangulated_landmarks = 0;  // LocalMappingOptions::triangulation
   int culled_landmarks = 0;
   int fused_landmarks = 0;
   int culled_keyframes = 0;  // both rules together

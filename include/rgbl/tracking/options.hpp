@@ -10,6 +10,7 @@
 #include "rgbl/geometry/scan_agreement.hpp"
 #include "rgbl/geometry/scan_registration.hpp"
 #include "rgbl/map/fusion.hpp"
+#include "rgbl/map/triangulation.hpp"
 #include "rgbl/map/map.hpp"
 
 namespace rgbl {
@@ -266,6 +267,13 @@ struct LocalMappingOptions {
   // After each local BA, every adjusted landmark's depth sigmas scaled by how far its depths disagree
   // with its keyframes' parallax (depth_consistency_scale, map/depth_consistency.hpp).
   bool depth_consistency = false;
+  // Landmarks triangulated between the keyframe and its covisible ones for keypoints without depth
+  // (triangulate_landmarks, map/triangulation.hpp); under the same culling as the depth landmarks.
+  bool triangulation = false;
+  TriangulationOptions triangulation_match;
+  // A triangulated landmark is kept only when the keyframe's fusion finds it in this many keyframes
+  // (2: the two it was made from are enough).
+  int triangulation_min_views = 3;
   bool local_ba = true;
   bool keyframe_culling = true;
   bool fusion = true;
