@@ -387,3 +387,90 @@ TEST_CASE("local mapping weighs a hedge's depths by how far they disagree with i
   CHECK(on.hedge_error < 0.6 * off.hedge_error);
   CHECK(on.other_error <= 1.1 * off.other_error);
 }
+
+namespace {
+
+// Three keyframes 0.5 m apart over random points 6-14 m ahead; the first 30 points have depth and
+// landmarks seen by all three (the covisibility), the rest neither, as far points without a return;
+// every fifth of those the first keyframe does not recognise.
+// Local mapping of the last keyframe with triangulation on, nothing else that adds or removes.
+struct TriangulatedScene {
+  rgbl::test::PointsMap scene;
+  rgbl::Map map;
+  rgbl::LocalMappingStats stats;
+};
+
+void map_with_triangulation(TriangulatedScene& t, int min_views) {
+  constexpr std::size_t kWithDepth = 30;
+  t.scene = rgbl::test::make_points_map(3, 150, 5);
+  for (int k = 0; k < 3; ++k) {
+    rgbl::Keyframe kf = rgbl::test::make_points_keyframe(t.scene, k, t.scene.T_cam_world[static_cast<std::size_t>(k)]);
+    for (std::size_t i = kWithDepth; i < t.scene.points.size(); ++i) {
+      int& kp = t.scene.keypoint_of_point[static_cast<std::size_t>(k)][i];
+      if (kp < 0) continue;
+      kf.depth[static_cast<std::size_t>(kp)] = 0.0F;
+      kf.depth_sigma[static_cast<std::size_t>(kp)] = 0.0F;
+      if (k == 0 && i % 5 == 0) {
+        // every fifth point looks different to the first keyframe (64 bits away): two views only
+        for (std::size_t byte = 0; byte < 8; ++byte) kf.descriptors[static_cast<std::size_t>(kp)][byte] ^= 0xFF;
+        kp = -1;
+      }
+    }
+    t.map.add_keyframe(std::move(kf));
+  }
+  for (std::size_t i = 0; i < kWithDepth; ++i) {
+    const rgbl::LandmarkId l = t.map.add_landmark(t.scene.points[i], rgbl::KeyframeId{0});
+    for (int k = 0; k < 3; ++k) {
+      const int kp = t.scene.keypoint_of_point[static_cast<std::size_t>(k)][i];
+      if (kp >= 0) t.map.add_observation(l, rgbl::KeyframeId{k}, kp);
+    }
+    t.map.update_landmark(l);
+  }
+  for (int k = 0; k < 3; ++k) t.map.update_covisibility(rgbl::KeyframeId{k});
+  rgbl::LocalMappingOptions options;
+  options.triangulation = true;
+  options.triangulation_min_views = min_views;
+  options.max_new_depth_points = 0;
+  options.local_ba = false;
+  options.keyframe_culling = false;
+  rgbl::LocalMapper mapper(t.map, t.scene.camera, options);
+  t.stats = mapper.process(rgbl::KeyframeId{2});
+}
+
+}  // namespace
+
+TEST_CASE("local mapping triangulates keypoints without depth and keeps what a third keyframe sees") {
+  for (const int min_views : {3, 2}) {
+    TriangulatedScene t;
+    map_with_triangulation(t, min_views);
+    const auto& seen = t.scene.keypoint_of_point;
+    int in_all = 0, in_two = 0;
+    for (std::size_t i = 30; i < t.scene.points.size(); ++i) {
+      const int views = (seen[0][i] >= 0 ? 1 : 0) + (seen[1][i] >= 0 ? 1 : 0);
+      if (seen[2][i] < 0 || views == 0) continue;
+      ++(views == 2 ? in_all : in_two);
+    }
+    REQUIRE(in_all > 40);
+    REQUIRE(in_two > 5);
+    INFO("min_views " << min_views);
+    CHECK(t.stats.triangulated_landmarks == (min_views == 3 ? in_all : in_all + in_two));
+    // each new landmark sits on its point and is seen by every keyframe that sees that point
+    int checked = 0;
+    double worst = 0.0;
+    for (std::size_t i = 30; i < t.scene.points.size(); ++i) {
+      if (seen[2][i] < 0) continue;
+      const rgbl::LandmarkId id = t.map.keyframe(rgbl::KeyframeId{2})->landmarks[static_cast<std::size_t>(seen[2][i])];
+      if (!id.valid()) continue;
+      const rgbl::Landmark& l = *t.map.landmark(id);
+      for (int k = 0; k < 3; ++k) {
+        const int kp = seen[static_cast<std::size_t>(k)][i];
+        CHECK((kp >= 0 ? l.observations.count(rgbl::KeyframeId{k}) == 1 && l.observations.at(rgbl::KeyframeId{k}) == kp
+                       : l.observations.count(rgbl::KeyframeId{k}) == 0));
+      }
+      worst = std::max(worst, (l.position - t.scene.points[i]).norm());
+      ++checked;
+    }
+    CHECK(checked == t.stats.triangulated_landmarks);
+    CHECK(worst < 1e-3);
+  }
+}
