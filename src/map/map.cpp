@@ -12,6 +12,17 @@ int Keyframe::landmark_count() const {
   return static_cast<int>(std::count_if(landmarks.begin(), landmarks.end(), [](LandmarkId l) { return l.valid(); }));
 }
 
+double Keyframe::median_depth() const {
+  std::vector<float> usable;
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    if (depth_sigma[i] > 0.0F) usable.push_back(depth[i]);
+  }
+  if (usable.empty()) return 0.0;
+  const auto middle = usable.begin() + static_cast<std::ptrdiff_t>(usable.size() / 2);
+  std::nth_element(usable.begin(), middle, usable.end());
+  return *middle;
+}
+
 int Keyframe::tracked_landmarks(int min_observations, const Map& map) const {
   int n = 0;
   for (const LandmarkId landmark_id : landmarks) {

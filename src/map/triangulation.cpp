@@ -2,10 +2,10 @@
 
 #include "rgbl/core/error.hpp"
 #include "rgbl/features/matcher.hpp"
+#include "rgbl/geometry/se3.hpp"
 
 #include <algorithm>
 #include <climits>
-#include <cstdint>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -66,23 +66,6 @@ std::vector<bool> open_keypoints(const Keyframe& kf, const PinholeCamera& camera
     open[i] = !on_moving;
   }
   return open;
-}
-
-double median_depth(const Keyframe& kf) {
-  std::vector<float> depths;
-  for (std::size_t i = 0; i < kf.depth.size(); ++i) {
-    if (kf.depth_sigma[i] > 0.0F) depths.push_back(kf.depth[i]);
-  }
-  if (depths.empty()) return 0.0;
-  const auto middle = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2);
-  std::nth_element(depths.begin(), middle, depths.end());
-  return *middle;
-}
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
 }
 
 // Clips the segment a-b to the rectangle [lo, hi] (Liang-Barsky); false when nothing is left.
@@ -179,11 +162,7 @@ std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> epipolar_segment(cons
   if (z(rho_lo) <= kFront && z(rho_hi) <= kFront) return std::nullopt;
   if (z(rho_lo) <= kFront) rho_lo = (kFront - far.z()) / t.z();
   if (z(rho_hi) <= kFront) rho_hi = (kFront - far.z()) / t.z();
-  const auto pixel = [&](double rho) {
-    const Eigen::Vector3d p = far + t * rho;
-    return Eigen::Vector2d(camera.fx * p.x() / p.z() + camera.cx, camera.fy * p.y() / p.z() + camera.cy);
-  };
-  Eigen::Vector2d a = pixel(rho_lo), b = pixel(rho_hi);
+  Eigen::Vector2d a = camera.project_unchecked(far + t * rho_lo), b = camera.project_unchecked(far + t * rho_hi);
   if (!clip_segment(a, b, Eigen::Vector2d(-margin, -margin), Eigen::Vector2d(camera.width + margin, camera.height + margin)))
     return std::nullopt;
   return std::pair{a, b};
@@ -191,7 +170,7 @@ std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> epipolar_segment(cons
 
 struct Proposal {
   std::size_t own = 0, other = 0;
-  int distance = INT_MAX;
+  int distance = 0;  // Hamming
 };
 
 }  // namespace
@@ -222,13 +201,13 @@ std::vector<LandmarkId> triangulate_landmarks(Map& map, const PinholeCamera& cam
   const auto variance = [&](int level) {
     return level_variance[std::min(static_cast<std::size_t>(std::max(level, 0)), level_variance.size() - 1)];
   };
+  // adding landmarks and observations below erases nothing: the keyframe pointers stay valid
   for (const KeyframeId other_id : map.best_covisible(id, static_cast<std::size_t>(options.covisible_keyframes))) {
-    kf = map.keyframe(id);
     const Keyframe* other = map.keyframe(other_id);
-    if (other == nullptr || kf == nullptr) continue;
+    if (other == nullptr) continue;
     const Eigen::Vector3d own_centre = kf->center(), other_centre = other->center();
     const double baseline = (own_centre - other_centre).norm();
-    const double depth = median_depth(*other);
+    const double depth = other->median_depth();
     if (depth <= 0.0 || baseline < options.min_baseline_ratio * depth) continue;
 
     const std::vector<bool> other_open = open_keypoints(*other, camera, options);
@@ -238,7 +217,7 @@ std::vector<LandmarkId> triangulate_landmarks(Map& map, const PinholeCamera& cam
     }
     // x_other^T E x_own = 0 on normalised rays
     const Eigen::Isometry3d T_other_own = other->T_cam_world * kf->T_cam_world.inverse();
-    const Eigen::Matrix3d E = skew(T_other_own.translation()) * T_other_own.linear();
+    const Eigen::Matrix3d E = hat(T_other_own.translation()) * T_other_own.linear();
 
     std::vector<Proposal> proposals;
     OpenCells cells(*other, other_open, camera.width, camera.height, 16.0);
@@ -274,11 +253,6 @@ std::vector<LandmarkId> triangulate_landmarks(Map& map, const PinholeCamera& cam
     });
     std::vector<bool> taken(other->keypoints.size(), false);
     const Eigen::Isometry3d T_world_own = kf->T_cam_world.inverse(), T_world_other = other->T_cam_world.inverse();
-    struct NewPoint {
-      Eigen::Vector3d position;
-      std::size_t own, other;
-    };
-    std::vector<NewPoint> points;
     for (const Proposal& p : proposals) {
       if (taken[p.other]) continue;
       const Eigen::Vector3d d_own = (T_world_own.linear() * own_rays[p.own]).normalized();
@@ -309,14 +283,11 @@ std::vector<LandmarkId> triangulate_landmarks(Map& map, const PinholeCamera& cam
       const double ratio_octave = std::pow(scale_factor, kp_own.level - kp_other.level);
       if (ratio_distance * ratio_factor < ratio_octave || ratio_distance > ratio_octave * ratio_factor) continue;
       taken[p.other] = true;
-      points.push_back({X, p.own, p.other});
-    }
-    for (const NewPoint& p : points) {
-      const LandmarkId l = map.add_landmark(p.position, id);
+      own_open[p.own] = false;
+      const LandmarkId l = map.add_landmark(X, id);
       map.add_observation(l, id, static_cast<int>(p.own));
       map.add_observation(l, other_id, static_cast<int>(p.other));
       map.update_landmark(l);
-      own_open[p.own] = false;
       created.push_back(l);
     }
   }

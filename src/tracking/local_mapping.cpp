@@ -314,14 +314,9 @@ int LocalMapper::cull_keyframes(KeyframeId id) {
 int LocalMapper::cull_revisited(KeyframeId id) {
   const Keyframe* current = map_.keyframe(id);
   if (current == nullptr) return 0;
-  std::vector<float> depths;
-  for (std::size_t i = 0; i < current->keypoints.size(); ++i) {
-    if (current->depth_sigma[i] > 0.0F) depths.push_back(current->depth[i]);
-  }
-  if (depths.empty()) return 0;
-  const auto middle = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2);
-  std::nth_element(depths.begin(), middle, depths.end());
-  const double radius = options_.place_distance_ratio * static_cast<double>(*middle);
+  const double median_depth = current->median_depth();
+  if (median_depth <= 0.0) return 0;
+  const double radius = options_.place_distance_ratio * median_depth;
   const double min_cos = std::cos(options_.place_angle_deg * std::numbers::pi / 180.0);
   const Eigen::Vector3d centre = current->center();
   const Eigen::Vector3d axis = current->T_cam_world.linear().row(2).transpose();  // optical axis in the world

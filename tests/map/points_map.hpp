@@ -67,4 +67,30 @@ inline Keyframe make_points_keyframe(PointsMap& s, int k, const Eigen::Isometry3
   return kf;
 }
 
+// Keyframe k's keypoints of the points from `first` on lose their depth, as far points without a
+// LiDAR return.
+inline void drop_depth(const PointsMap& s, int k, std::size_t first, Keyframe& kf) {
+  for (std::size_t i = first; i < s.points.size(); ++i) {
+    const int kp = s.keypoint_of_point[static_cast<std::size_t>(k)][i];
+    if (kp < 0) continue;
+    kf.depth[static_cast<std::size_t>(kp)] = 0.0F;
+    kf.depth_sigma[static_cast<std::size_t>(kp)] = 0.0F;
+  }
+}
+
+// A landmark at each of the first `count` points, observed by every keyframe of the map that sees it
+// (the map's keyframes are the scene's, in order), and the covisibility that gives.
+inline void add_shared_landmarks(const PointsMap& s, std::size_t count, Map& map) {
+  const std::size_t keyframes = s.keypoint_of_point.size();
+  for (std::size_t i = 0; i < count; ++i) {
+    const LandmarkId l = map.add_landmark(s.points[i], KeyframeId{0});
+    for (std::size_t k = 0; k < keyframes; ++k) {
+      const int kp = s.keypoint_of_point[k][i];
+      if (kp >= 0) map.add_observation(l, KeyframeId{static_cast<int>(k)}, kp);
+    }
+    map.update_landmark(l);
+  }
+  for (std::size_t k = 0; k < keyframes; ++k) map.update_covisibility(KeyframeId{static_cast<int>(k)});
+}
+
 }  // namespace rgbl::test

@@ -22,26 +22,11 @@ void make_two_views(TwoViews& t, int count, std::size_t with_depth) {
   t.scene = rgbl::test::make_points_map(2, count);
   rgbl::Keyframe ka = rgbl::test::make_points_keyframe(t.scene, 0, t.scene.T_cam_world[0]);
   rgbl::Keyframe kb = rgbl::test::make_points_keyframe(t.scene, 1, t.scene.T_cam_world[1]);
-  for (std::size_t i = with_depth; i < t.scene.points.size(); ++i) {
-    for (auto [k, kf] : {std::pair{0, &ka}, std::pair{1, &kb}}) {
-      const int kp = t.scene.keypoint_of_point[static_cast<std::size_t>(k)][i];
-      if (kp < 0) continue;
-      kf->depth[static_cast<std::size_t>(kp)] = 0.0F;
-      kf->depth_sigma[static_cast<std::size_t>(kp)] = 0.0F;
-    }
-  }
+  rgbl::test::drop_depth(t.scene, 0, with_depth, ka);
+  rgbl::test::drop_depth(t.scene, 1, with_depth, kb);
   t.a = t.map.add_keyframe(std::move(ka));
   t.b = t.map.add_keyframe(std::move(kb));
-  for (std::size_t i = 0; i < with_depth; ++i) {
-    const int kpa = t.scene.keypoint_of_point[0][i], kpb = t.scene.keypoint_of_point[1][i];
-    if (kpa < 0 || kpb < 0) continue;
-    const rgbl::LandmarkId l = t.map.add_landmark(t.scene.points[i], t.a);
-    t.map.add_observation(l, t.a, kpa);
-    t.map.add_observation(l, t.b, kpb);
-    t.map.update_landmark(l);
-  }
-  t.map.update_covisibility(t.a);
-  t.map.update_covisibility(t.b);
+  rgbl::test::add_shared_landmarks(t.scene, with_depth, t.map);
 }
 
 // Points without depth that both keyframes see: what triangulation can make.

@@ -405,28 +405,17 @@ void map_with_triangulation(TriangulatedScene& t, int min_views) {
   t.scene = rgbl::test::make_points_map(3, 150, 5);
   for (int k = 0; k < 3; ++k) {
     rgbl::Keyframe kf = rgbl::test::make_points_keyframe(t.scene, k, t.scene.T_cam_world[static_cast<std::size_t>(k)]);
-    for (std::size_t i = kWithDepth; i < t.scene.points.size(); ++i) {
-      int& kp = t.scene.keypoint_of_point[static_cast<std::size_t>(k)][i];
+    rgbl::test::drop_depth(t.scene, k, kWithDepth, kf);
+    for (std::size_t i = kWithDepth; k == 0 && i < t.scene.points.size(); i += 5) {
+      // every fifth point looks different to the first keyframe (64 bits away): two views only
+      int& kp = t.scene.keypoint_of_point[0][i];
       if (kp < 0) continue;
-      kf.depth[static_cast<std::size_t>(kp)] = 0.0F;
-      kf.depth_sigma[static_cast<std::size_t>(kp)] = 0.0F;
-      if (k == 0 && i % 5 == 0) {
-        // every fifth point looks different to the first keyframe (64 bits away): two views only
-        for (std::size_t byte = 0; byte < 8; ++byte) kf.descriptors[static_cast<std::size_t>(kp)][byte] ^= 0xFF;
-        kp = -1;
-      }
+      for (std::size_t byte = 0; byte < 8; ++byte) kf.descriptors[static_cast<std::size_t>(kp)][byte] ^= 0xFF;
+      kp = -1;
     }
     t.map.add_keyframe(std::move(kf));
   }
-  for (std::size_t i = 0; i < kWithDepth; ++i) {
-    const rgbl::LandmarkId l = t.map.add_landmark(t.scene.points[i], rgbl::KeyframeId{0});
-    for (int k = 0; k < 3; ++k) {
-      const int kp = t.scene.keypoint_of_point[static_cast<std::size_t>(k)][i];
-      if (kp >= 0) t.map.add_observation(l, rgbl::KeyframeId{k}, kp);
-    }
-    t.map.update_landmark(l);
-  }
-  for (int k = 0; k < 3; ++k) t.map.update_covisibility(rgbl::KeyframeId{k});
+  rgbl::test::add_shared_landmarks(t.scene, kWithDepth, t.map);
   rgbl::LocalMappingOptions options;
   options.triangulation = true;
   options.triangulation_min_views = min_views;

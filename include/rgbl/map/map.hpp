@@ -71,6 +71,8 @@ struct Keyframe {
 
   Eigen::Vector3d center() const { return T_cam_world.inverse().translation(); }
   int landmark_count() const;
+  // Median of the usable keypoint depths (depth_sigma > 0), metres; 0 when there are none.
+  double median_depth() const;
   // Landmarks seen at least min_observations times.
   int tracked_landmarks(int min_observations, const class Map& map) const;
 };

@@ -3,7 +3,7 @@
 // keyframes along the epipolar line and triangulated from the two rays (ORB-SLAM3's local mapping makes
 // them for every sensor). On KITTI two thirds of the keypoints have no depth, most of them far: the
 // points that pin rotation best. A keypoint whose nearest depth-bearing neighbour lies on something
-// moving (Keyframe::depth_sigma 0 with a depth) is left out, so a truck alongside gives no points.
+// the tracker found moving (Keyframe::depth_sigma 0 with a depth) is left out.
 
 #include "rgbl/geometry/camera.hpp"
 #include "rgbl/map/map.hpp"
@@ -19,7 +19,7 @@ struct TriangulationOptions {
   double min_parallax_deg = 1.0;     // angle between the two rays at the point
   double min_depth = 0.5;            // m; the nearest point searched for along a keypoint's ray
   // The triangulated depth's sigma against the depth, from the two keypoints' level sigmas over the
-  // parallax: sqrt(s_own^2 + s_other^2) / fx / parallax (radians). ORB-SLAM's 1 deg alone keeps points
+  // parallax: sqrt(s_own^2 + s_other^2) / fx / parallax (radians). A 1 deg bound alone keeps points
   // known to 11 % (KITTI, level 0) or 23 % (the simulator's half-size images), worse at higher levels;
   // on the simulator's repeated street 15 % of those came out more than 50 % off (docs/accuracy.md).
   double max_depth_sigma_relative = 0.1;
