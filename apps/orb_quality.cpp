@@ -8,7 +8,8 @@
 //    and matched by match_guided (radius 15 px x scale^level, ratio 0.8, rotation histogram).
 // A match "agrees with the true motion" when its Sampson distance to the epipolar geometry of the
 // ground-truth relative pose is below 1 px; a fundamental-matrix RANSAC (1 px, 0.999) is reported
-// for the global matches as well.
+// for the global matches as well. "guided Sampson" is the median Sampson distance of the guided matches
+// that agree: how precisely a keypoint lands on the same structure in both frames.
 #include "rgbl/core/timer.hpp"
 #include "rgbl/features/matcher.hpp"
 #include "rgbl/features/orb.hpp"
@@ -47,6 +48,7 @@ struct Totals {
   double features = 0, matches = 0, gt_inliers = 0, ransac_inliers = 0, extract_ms = 0;
   double occupied = 0;  // share of a 32 x 10 grid's cells (~38 px) holding a keypoint, summed over frames
   double guided_queries = 0, guided_matches = 0, guided_gt_inliers = 0;
+  std::vector<double> guided_sampson;  // of the agreeing guided matches, px
   int pairs = 0;
 };
 
@@ -127,7 +129,11 @@ void accumulate_guided(Totals& t, const Features& a, const Features& b, const rg
     t.guided_matches += 1.0;
     const auto& pa = a.points[static_cast<std::size_t>(source[q])];
     const auto& pb = b.points[static_cast<std::size_t>(result[q])];
-    if (sampson_px(F, pa, pb) < 1.0) t.guided_gt_inliers += 1.0;
+    const double sampson = sampson_px(F, pa, pb);
+    if (sampson < 1.0) {
+      t.guided_gt_inliers += 1.0;
+      t.guided_sampson.push_back(sampson);
+    }
   }
 }
 
@@ -162,14 +168,21 @@ void accumulate(Totals& t, const Features& a, const Features& b, const Eigen::Ma
   ++t.pairs;
 }
 
-void print_row(const char* name, const Totals& t) {
+void print_row(const char* name, Totals& t) {
   const double n = t.pairs;
-  fmt::print("| {:<8} | {:8.0f} | {:7.1f}% | {:9.2f} | {:8.1f} | {:>16} | {:>16} | {:8.1f} | {:8.1f} | {:>16} |\n", name,
+  double median_sampson = 0.0;
+  if (!t.guided_sampson.empty()) {
+    const auto mid = t.guided_sampson.begin() + static_cast<std::ptrdiff_t>(t.guided_sampson.size() / 2);
+    std::nth_element(t.guided_sampson.begin(), mid, t.guided_sampson.end());
+    median_sampson = *mid;
+  }
+  fmt::print("| {:<8} | {:8.0f} | {:7.1f}% | {:9.2f} | {:8.1f} | {:>16} | {:>16} | {:8.1f} | {:8.1f} | {:>16} | {:.3f} |\n", name,
              t.features / n, 100.0 * t.occupied / n, t.extract_ms / n, t.matches / n,
              fmt::format("{:.1f} ({:.1f}%)", t.gt_inliers / n, 100.0 * t.gt_inliers / t.matches),
              fmt::format("{:.1f} ({:.1f}%)", t.ransac_inliers / n, 100.0 * t.ransac_inliers / t.matches),
              t.guided_queries / n, t.guided_matches / n,
-             fmt::format("{:.1f} ({:.1f}%)", t.guided_gt_inliers / n, 100.0 * t.guided_gt_inliers / t.guided_matches));
+             fmt::format("{:.1f} ({:.1f}%)", t.guided_gt_inliers / n, 100.0 * t.guided_gt_inliers / t.guided_matches),
+             median_sampson);
 }
 
 }  // namespace
@@ -254,8 +267,8 @@ int main(int argc, char** argv) {
                "geometry < 1 px. occupied cells: share of a 32 x 10 grid holding a keypoint.\n\n",
                pairs, seq.string(), orb_options.features_per_node, orb_options.spread_fraction);
     fmt::print("| extractor | features | occupied cells | ms/frame | global matches | global agree | F-RANSAC inliers | guided queries "
-               "| guided matches | guided agree |\n");
-    fmt::print("|---|---|---|---|---|---|---|---|---|---|\n");
+               "| guided matches | guided agree | guided Sampson px |\n");
+    fmt::print("|---|---|---|---|---|---|---|---|---|---|---|\n");
     print_row("rgbl", ours);
     print_row("cv::ORB", theirs);
     return 0;
