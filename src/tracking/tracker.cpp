@@ -898,7 +898,6 @@ bool Tracker::track_reference_keyframe(Frame& frame, std::vector<OtherStart>& ot
   if (static_cast<int>(matches.size()) < options_.reference_min_matches) return false;
   for (const auto& [q, t] : matches) frame.landmarks[static_cast<std::size_t>(q)] = train_landmarks[static_cast<std::size_t>(t)];
   const std::optional<Eigen::Isometry3d> T_lidar = lidar_start(lidar, frame);
-  const Frame matched_frame = T_lidar ? frame : Frame{};
   // Start from the frame-to-frame motion from depth where its consensus is strong (the frame right
   // after initialisation has no velocity yet, and the last pose is then a poor guess at speed), else
   // from the last pose, and then also from the weak consensus: far off at speed, the last pose can
@@ -940,28 +939,22 @@ bool Tracker::track_reference_keyframe(Frame& frame, std::vector<OtherStart>& ot
     }
   }
   if (T_lidar) {
-    // a rival: its views count only if it wins; no consensus labels its moving points
-    OtherStart& other = others.emplace_back(OtherStart{matched_frame, true, true});
-    other.frame.moving.clear();
-    start_from(other.frame, *T_lidar);
+    // A rival: its views count only if it wins. It stands on the scans, not on the brute-force
+    // matches: at 1 Hz those hold few right ones, and where a vehicle alongside moves with the camera
+    // they hold its points, which the gate does not drop far ahead (6 % of the depth is more than the
+    // step at 25 m), and which pulled the LiDAR's start back onto the standing start (traffic seed 7,
+    // frame 1: 1.10 m ahead, optimised to 0.05 m from standing still, the truth 1.0 m). The local map,
+    // searched from the LiDAR's pose with its depth gate, refines it.
+    OtherStart& other = others.emplace_back(OtherStart{frame, true, true});
+    clear_matches(other.frame);
+    other.frame.T_cam_world = *T_lidar * last_frame_->T_cam_world;
   }
   auto optimise = [&](Frame& f) {
     const int inliers = optimise_pose(f);
     discard_outliers(f);
     return inliers >= options_.min_pose_inliers;
   };
-  std::erase_if(others, [&](OtherStart& other) {
-    if (optimise(other.frame)) return false;
-    // The LiDAR's start stands on the scans, not on these matches: at 1 Hz the brute-force matches
-    // against the reference keyframe hold few right ones; the local map searched from its pose decides.
-    if (other.from_lidar) {
-      const Eigen::Isometry3d T = *T_lidar * last_frame_->T_cam_world;
-      clear_matches(other.frame);
-      other.frame.T_cam_world = T;
-      return false;
-    }
-    return true;
-  });
+  std::erase_if(others, [&](OtherStart& other) { return !other.from_lidar && !optimise(other.frame); });
   return optimise(frame);
 }
 
