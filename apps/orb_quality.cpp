@@ -168,21 +168,22 @@ void accumulate(Totals& t, const Features& a, const Features& b, const Eigen::Ma
   ++t.pairs;
 }
 
-void print_row(const char* name, Totals& t) {
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+void print_row(const char* name, const Totals& t) {
   const double n = t.pairs;
-  double median_sampson = 0.0;
-  if (!t.guided_sampson.empty()) {
-    const auto mid = t.guided_sampson.begin() + static_cast<std::ptrdiff_t>(t.guided_sampson.size() / 2);
-    std::nth_element(t.guided_sampson.begin(), mid, t.guided_sampson.end());
-    median_sampson = *mid;
-  }
   fmt::print("| {:<8} | {:8.0f} | {:7.1f}% | {:9.2f} | {:8.1f} | {:>16} | {:>16} | {:8.1f} | {:8.1f} | {:>16} | {:.3f} |\n", name,
              t.features / n, 100.0 * t.occupied / n, t.extract_ms / n, t.matches / n,
              fmt::format("{:.1f} ({:.1f}%)", t.gt_inliers / n, 100.0 * t.gt_inliers / t.matches),
              fmt::format("{:.1f} ({:.1f}%)", t.ransac_inliers / n, 100.0 * t.ransac_inliers / t.matches),
              t.guided_queries / n, t.guided_matches / n,
              fmt::format("{:.1f} ({:.1f}%)", t.guided_gt_inliers / n, 100.0 * t.guided_gt_inliers / t.guided_matches),
-             median_sampson);
+             median(t.guided_sampson));
 }
 
 }  // namespace

@@ -174,14 +174,15 @@ class Tracker {
     return options_.ransac_motion_prior && velocity_steady_ ? velocity_ : std::nullopt;
   }
   // Another start against the reference keyframe: from a depth consensus too weak to be the only
-  // start, or (rival) from a second rigid motion among the matches.
+  // start, or (rival) from a second rigid motion among the matches, or (rival, from_lidar) the LiDAR's
+  // own start, at its pose without matches.
   struct OtherStart {
     Frame frame;
     bool rival = false;
     bool from_lidar = false;  // the LiDAR's own start (lidar_start)
   };
   // Matches the reference keyframe's points by descriptor and optimises the pose. `others` receives the
-  // other starts that converged too (the weak consensus first).
+  // other starts that converged too (the weak consensus first), and the LiDAR's start as it is.
   bool track_reference_keyframe(Frame& frame, std::vector<OtherStart>& others,
                                 std::optional<LidarView>& lidar) const;
   // Unmatches keypoints labelled moving and those whose landmark disagrees with frame.T_cam_world (a
