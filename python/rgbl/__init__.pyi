@@ -329,6 +329,7 @@ class TrackResult:
     new_map: bool
     jump: bool
     step_rejected: bool
+    step_registered: bool  # a rejected step's frame placed by its scan's registration onto the last frame's
     gap: bool  # the first frame after a gap in the timestamps, its scan registered onto the last one's
     gap_registered: bool  # ...and the registration was accepted as the prediction
     lost_registered: bool  # a lost frame placed by its scan's registration onto the last frame's

@@ -424,6 +424,10 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.direction_prior = flag("Tracking.DirectionPrior");
   s.register_gaps = flag("Tracking.RegisterGaps");
   s.register_lost = flag("Tracking.RegisterLost");
+  s.register_refused_steps = flag("Tracking.RegisterRefusedSteps");
+  s.ransac_points_near_prior = r.integer({"Tracking.RansacPointsNearPrior"});
+  if (s.ransac_points_near_prior && *s.ransac_points_near_prior < 3)
+    r.fail("Tracking.RansacPointsNearPrior", "at least 3 keypoints (a rigid motion needs 3 points)");
   s.depth_consistency = flag("LocalMapping.DepthConsistency");
   s.triangulation = flag("LocalMapping.Triangulation");
 

@@ -169,6 +169,8 @@ std::string summary_json(const RunResult& run) {
   // steps beyond a vehicle's reach: taken on strong evidence, or rejected (the frame placed at the prediction)
   j["jump_frames"] = run.frames_where([](const TrackResult& r) { return r.jump; });
   j["rejected_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_rejected; });
+  // ...of those, the ones placed by their scan's registration onto the last frame's
+  j["registered_rejected_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_registered; });
   // first frames after a gap in the timestamps whose scan was registered across it, and those where
   // the registration was accepted as the prediction
   j["gap_frames"] = run.frames_where([](const TrackResult& r) { return r.gap; });
@@ -228,6 +230,11 @@ std::string summary_text(const RunResult& run) {
     const auto registered = run.frames_where([](const TrackResult& r) { return r.gap_registered; });
     fmt::format_to(out, "  gaps in the frames before frame(s) {}; the scans registered across the gap at: {}\n",
                    fmt::join(gaps, ", "), registered.empty() ? "none" : fmt::format("{}", fmt::join(registered, ", ")));
+  }
+  const auto refused = run.frames_where([](const TrackResult& r) { return r.step_registered; });
+  if (!refused.empty()) {
+    fmt::format_to(out, "  refused step(s) placed by the scans (not the constant-velocity guess): {}\n",
+                   fmt::join(refused, ", "));
   }
   const auto placed = run.frames_where([](const TrackResult& r) { return r.lost_registered; });
   if (!placed.empty()) {

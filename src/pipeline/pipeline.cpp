@@ -100,6 +100,10 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.direction_prior) p.system.tracker.direction_prior = *s.direction_prior;
   if (s.register_gaps) p.system.tracker.register_gaps = *s.register_gaps;
   if (s.register_lost) p.system.tracker.register_lost = *s.register_lost;
+  if (s.register_refused_steps) p.system.tracker.register_refused_steps = *s.register_refused_steps;
+  if (s.ransac_points_near_prior) {
+    p.system.tracker.ransac_max_points_near_prior = static_cast<std::size_t>(*s.ransac_points_near_prior);
+  }
   if (s.depth_consistency) p.system.mapping.depth_consistency = *s.depth_consistency;
   if (s.triangulation) p.system.mapping.triangulation = *s.triangulation;
   if (s.bf || s.th_depth) {

@@ -55,6 +55,8 @@ void TrackerOptions::validate() const {
   require(relocalisation_ransac_confidence > 0.0 && relocalisation_ransac_confidence < 1.0,
           "tracker.relocalisation_ransac_confidence", "in (0, 1)");
   require(ransac_iterations >= 1, "tracker.ransac_iterations", ">= 1");
+  require(ransac_max_points >= 3 && ransac_max_points_near_prior >= 3, "tracker.ransac_max_points",
+          ">= 3 keypoints (a rigid motion needs 3 points), with a prior and without");
   require(ransac_min_inliers >= 3, "tracker.ransac_min_inliers", ">= 3 (a rigid motion needs 3 points)");
   require(ransac_guess_min_inliers >= 3, "tracker.ransac_guess_min_inliers", ">= 3 (a rigid motion needs 3 points)");
   require(ransac_coverage_cell >= 0.0, "tracker.ransac_coverage_cell", ">= 0 px (0 = rank by size only)");

@@ -215,11 +215,12 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     const int cy = std::max(0, static_cast<int>(kp.y / cell_size));
     return cy * cells_x + std::min(cx, cells_x - 1);
   };
-  // A strided subset of the current keypoints is enough for a 6-DoF consensus and bounds the cost.
+  // A strided subset of the current keypoints bounds the cost; near a prior a larger one (options.hpp).
   std::size_t with_depth = 0;
   for (std::size_t i = 0; i < frame.size(); ++i) with_depth += frame.depth_sigma[i] > 0.0F ? 1 : 0;
-  const std::size_t stride = std::max<std::size_t>(1, (with_depth + options.ransac_max_points - 1) /
-                                                          std::max<std::size_t>(1, options.ransac_max_points));
+  const std::size_t max_points = std::max<std::size_t>(
+      1, prior ? options.ransac_max_points_near_prior : options.ransac_max_points);
+  const std::size_t stride = std::max<std::size_t>(1, (with_depth + max_points - 1) / max_points);
   std::size_t seen = 0;
   for (std::size_t i = 0; i < frame.size(); ++i) {
     if (frame.depth_sigma[i] <= 0.0F) continue;

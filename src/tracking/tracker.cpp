@@ -83,7 +83,8 @@ int count_tracked(const Frame& frame) {
 // check's), the chosen one is committed once: nothing but commit() and initialisation changes state.
 TrackerOutcome Tracker::track(Frame& frame, bool mapping_idle, std::size_t keyframes_queued, PointCloudView scan) {
   TrackerOutcome outcome = track_frame(frame, mapping_idle, keyframes_queued, scan);
-  if ((options_.register_gaps || options_.register_lost) && T_cam_lidar_) last_scan_.assign(scan.begin(), scan.end());
+  const bool registers = options_.register_gaps || options_.register_lost || options_.register_refused_steps;
+  if (registers && T_cam_lidar_) last_scan_.assign(scan.begin(), scan.end());
   return outcome;
 }
 
@@ -110,7 +111,7 @@ TrackerOutcome Tracker::track_frame(Frame& frame, bool mapping_idle, std::size_t
     // A second hypothesis from the whole map, independent of any prediction, for a suspect pose and
     // before declaring the camera lost; taken when it explains more of the frame.
     Hypothesis relocalised = relocalisation_hypothesis(h.frame, h.reference, views);
-    if (relocalised.ok && relocalised.inliers > h.inliers) {
+    if (relocalised.ok && relocalised.inliers > h.inliers && !scans_refuse_relocalisation(relocalised, prediction)) {
       h = std::move(relocalised);
     } else if (!relocalised.ok && first.suspect) {
       h.ok = false;
@@ -133,6 +134,7 @@ TrackerOutcome Tracker::track_frame(Frame& frame, bool mapping_idle, std::size_t
     h = step_hypothesis(std::move(h), prediction, relocalisation_tried, views);
   }
   if (!h.ok) register_lost(h.frame, scan, prediction);
+  if (h.ok && h.step_rejected) register_refused_step(h, scan, prediction);
   commit(h, prediction, first, views, mapping_idle, keyframes_queued, outcome);
   frame = std::move(h.frame);
   if (outcome.new_map) return finish_initialised(frame, outcome);
@@ -184,25 +186,38 @@ void Tracker::register_gap(const Frame& frame, PointCloudView scan, Prediction& 
 
 void Tracker::register_lost(const Frame& frame, PointCloudView scan, Prediction& prediction) const {
   // a gap frame's registration was tried already, from the same guess
-  if (!options_.register_lost || prediction.gap || !T_cam_lidar_ || !last_frame_ || last_scan_.empty() ||
-      scan.empty()) {
-    return;
+  if (!options_.register_lost || prediction.gap) return;
+  if (const auto T_cam_world = register_onto_last(frame, scan, prediction, "lost")) {
+    prediction.T_cam_world = *T_cam_world;
+    prediction.registered = true;
   }
+}
+
+void Tracker::register_refused_step(Hypothesis& h, PointCloudView scan, const Prediction& prediction) const {
+  if (!options_.register_refused_steps || prediction.gap) return;
+  if (const auto T_cam_world = register_onto_last(h.frame, scan, prediction, "its step refused")) {
+    h.frame.T_cam_world = *T_cam_world;
+    h.step_registered = true;
+  }
+}
+
+std::optional<Eigen::Isometry3d> Tracker::register_onto_last(const Frame& frame, PointCloudView scan,
+                                                             const Prediction& prediction, const char* what) const {
+  if (!T_cam_lidar_ || !last_frame_ || last_scan_.empty() || scan.empty()) return std::nullopt;
   const double dt = frame.timestamp - last_frame_->timestamp;
-  if (!(dt > 0.0 && dt <= options_.max_gap_s)) return;
+  if (!(dt > 0.0 && dt <= options_.max_gap_s)) return std::nullopt;
   const Stopwatch watch;
   const auto g = register_across_gap(last_scan_, scan, *T_cam_lidar_,
                                      prediction.T_last_world * prediction.T_cam_world.inverse(), dt,
                                      options_.gap_registration, pool_.get());
-  if (!g) return;
-  logger()->debug("frame {}: lost; its scan registers onto the last one {:.2f} m, {:.2f} deg from the "
+  if (!g) return std::nullopt;
+  logger()->debug("frame {}: {}; its scan registers onto the last one {:.2f} m, {:.2f} deg from the "
                   "constant-velocity guess (at most {:.2f} m, {:.2f} deg): runner-up {:.3f} of {:.3f}, probe loss "
-                  "{:.3f}, {} ({:.0f} ms)", frame.index, g->moved_m, g->moved_deg, g->allowed_m, g->allowed_deg,
+                  "{:.3f}, {} ({:.0f} ms)", frame.index, what, g->moved_m, g->moved_deg, g->allowed_m, g->allowed_deg,
                   g->registration.runner_up_agreement, g->registration.agreement, g->registration.min_probe_loss,
                   g->accepted ? "its pose" : "not taken", watch.elapsed_ms());
-  if (!g->accepted) return;
-  prediction.T_cam_world = g->T_reference_query.inverse() * prediction.T_last_world;
-  prediction.registered = true;
+  if (!g->accepted) return std::nullopt;
+  return g->T_reference_query.inverse() * prediction.T_last_world;  // T_last_cur's inverse
 }
 
 Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction& prediction, ViewLog& views) const {
@@ -349,6 +364,23 @@ const Tracker::LidarView* Tracker::lidar_view(std::optional<LidarView>& cache, c
                             scan_evidence(*frame.scan, options_), {}});
   }
   return cache ? &*cache : nullptr;
+}
+
+bool Tracker::scans_refuse_relocalisation(const Hypothesis& relocalised, const Prediction& prediction) const {
+  // A relocalisation is not checked as a step is (it may follow a loss), so the frame right after a
+  // tracked one is judged here: a pose beyond a vehicle's reach of the prediction is taken only if the
+  // scans do not prefer the prediction. An image three frames old (04, frame 31 fed frame 28's) was
+  // relocalised 4.2 m off on 161 inliers and reported ok.
+  if (!options_.check_steps || !velocity_steady_ || !has_pose(state_) || !last_frame_ || prediction.registered) {
+    return false;
+  }
+  const Frame& frame = relocalised.frame;
+  const double dt = frame.timestamp - last_frame_->timestamp;
+  const Eigen::Vector3d last_centre = prediction.T_last_world.inverse().translation();
+  if (check_step(frame.T_cam_world, prediction.T_cam_world, last_centre, dt, options_).translation_plausible) return false;
+  std::optional<LidarView> lidar;
+  return lidar_preference(lidar, frame, frame.T_cam_world, prediction.T_cam_world, "the relocalisation",
+                          "the prediction", false) > 0;
 }
 
 int Tracker::lidar_preference(std::optional<LidarView>& cache, const Frame& frame, const Eigen::Isometry3d& T_a_world,
@@ -563,6 +595,7 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
   outcome.relocalised = h.relocalised;
   outcome.jump = h.jump;
   outcome.step_rejected = h.step_rejected;
+  outcome.step_registered = h.step_registered;
   outcome.gap = prediction.gap;
   outcome.gap_registered = prediction.registered;
   int inliers = h.inliers;
@@ -571,7 +604,11 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
     state_ = h.weak ? TrackState::Weak : support_state(inliers, frames_since_relocalisation(frame), options_);
     last_ok_frame_ = frame.index;
     last_inliers_ = inliers;
-    if (last_frame_ && !h.step_rejected) {
+    if (last_frame_ && h.step_registered) {
+      // the scans measured this motion where the images could not: the velocity from here on
+      velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
+      velocity_dt_ = frame.timestamp - last_frame_->timestamp;
+    } else if (last_frame_ && !h.step_rejected) {
       velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
       velocity_dt_ = frame.timestamp - last_frame_->timestamp;
       velocity_steady_ = consecutive && first.motion_ok && !h.relocalised;

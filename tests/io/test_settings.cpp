@@ -266,11 +266,12 @@ TEST_CASE("settings: the LiDAR pair's sigmas and the scan samples' elevation cor
   }
 }
 
-TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, RegisterGaps, CauchyWeights, ObjectTest, DirectionPrior, LocalMapping.DepthConsistency and Triangulation, read and validated", "[io][settings]") {
+TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, RegisterGaps, CauchyWeights, ObjectTest, DirectionPrior, RegisterRefusedSteps, RansacPointsNearPrior, LocalMapping.DepthConsistency and Triangulation, read and validated", "[io][settings]") {
   rgbl::test::TempDir tmp;
   const auto s = rgbl::read_settings(tmp.write(
       "t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0.25\nTracking.BoundedDepthError: 1\nTracking.RegisterGaps: 0\n"
                 "Tracking.CauchyWeights: 0\nTracking.ObjectTest: 1\nTracking.DirectionPrior: 0\n"
+                "Tracking.RegisterRefusedSteps: 0\nTracking.RansacPointsNearPrior: 500\n"
                 "LocalMapping.DepthConsistency: 1\nLocalMapping.Triangulation: 1\n"));
   REQUIRE(s.reference_landmark_ratio);
   CHECK(*s.reference_landmark_ratio == 0.25);
@@ -281,6 +282,8 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK(s.direction_prior == false);
   CHECK(s.depth_consistency == true);
   CHECK(s.triangulation == true);
+  CHECK(s.register_refused_steps == false);
+  CHECK(s.ransac_points_near_prior == 500);
   CHECK(s.warnings.empty());
   const auto unset = rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n"));
   CHECK_FALSE(unset.reference_landmark_ratio);
@@ -291,6 +294,12 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK_FALSE(unset.direction_prior);
   CHECK_FALSE(unset.depth_consistency);
   CHECK_FALSE(unset.triangulation);
+  CHECK_FALSE(unset.register_refused_steps);
+  CHECK_FALSE(unset.ransac_points_near_prior);
+  CHECK_THAT(error_of(tmp.write("refused.yaml", "%YAML:1.0\nTracking.RegisterRefusedSteps: 2\n")),
+             Contains("'Tracking.RegisterRefusedSteps': expected 0 (off) or 1 (on)"));
+  CHECK_THAT(error_of(tmp.write("points.yaml", "%YAML:1.0\nTracking.RansacPointsNearPrior: 2\n")),
+             Contains("'Tracking.RansacPointsNearPrior': expected at least 3 keypoints"));
   CHECK_THAT(error_of(tmp.write("tri.yaml", "%YAML:1.0\nLocalMapping.Triangulation: 2\n")),
              Contains("'LocalMapping.Triangulation'"));
   CHECK_THAT(error_of(tmp.write("gaps.yaml", "%YAML:1.0\nTracking.RegisterGaps: yes\n")),

@@ -6,6 +6,8 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <random>
 #include <vector>
@@ -287,4 +289,60 @@ TEST_CASE("road plane: the least-squares plane of the road's returns, the camera
   rgbl::ScanSample wall;
   for (double y = -3.0; y < 0.5; y += 0.01) wall.points.emplace_back(0.0F, static_cast<float>(y), 10.0F);
   CHECK_FALSE(rgbl::road_plane(wall, options));
+}
+
+TEST_CASE("frame motion: near a prior every keypoint with depth takes part, so a scene in few matches is found") {
+  // Vehicles hide most of the scene (traffic seed 7 of the simulator): of ~700 keypoints with depth per
+  // frame only 40 match the last frame's on the static scene. A strided subset of 350 keeps about half
+  // of those, short of ransac_min_inliers (30), and gives no prediction.
+  const rgbl::PinholeCamera cam = rgbl::test::kitti_camera();
+  std::mt19937 rng(5);
+  Eigen::Isometry3d T_true = Eigen::Isometry3d::Identity();
+  T_true.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);
+  Scene scene;
+  add_points(scene, rng, 40, {-6.0, -1.5, 8.0}, {6.0, 1.5, 40.0}, T_true);
+  auto [last, cur] = frames_of(scene, cam, rng);
+  // 660 keypoints with depth in each frame that match nothing (random descriptors: ~128 bits apart)
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::uniform_int_distribution<int> byte(0, 255);
+  for (rgbl::Frame* f : {&last, &cur}) {
+    for (int k = 0; k < 660; ++k) {
+      const Eigen::Vector3d p(-6.0 + 12.0 * u(rng), -1.5 + 3.0 * u(rng), 8.0 + 32.0 * u(rng));
+      const Eigen::Vector2d px = cam.project_unchecked(p);
+      rgbl::Keypoint kp;
+      kp.x = static_cast<float>(px.x());
+      kp.y = static_cast<float>(px.y());
+      rgbl::Descriptor d;
+      for (auto& b : d) b = static_cast<std::uint8_t>(byte(rng));
+      // interleaved with the scene's keypoints, as a detector lists them (by image cell)
+      const auto at = static_cast<std::ptrdiff_t>(rng() % (f->keypoints.size() + 1));
+      f->keypoints.insert(f->keypoints.begin() + at, kp);
+      f->descriptors.insert(f->descriptors.begin() + at, d);
+      f->depth.insert(f->depth.begin() + at, static_cast<float>(p.z()));
+      f->depth_sigma.insert(f->depth_sigma.begin() + at, 0.1F);
+    }
+  }
+  REQUIRE(cur.size() == 700);
+  Eigen::Isometry3d prior = T_true;  // the constant-velocity prior, 0.1 m off
+  prior.translation() += Eigen::Vector3d(0.05, 0.0, 0.08);
+  rgbl::TrackerOptions options;
+  REQUIRE(options.ransac_min_inliers == 30);
+  SECTION("with the prior every keypoint takes part: the scene's motion, exactly") {
+    const auto T = rgbl::estimate_frame_motion(cam, last, cur, options, prior);
+    REQUIRE(T);
+    CHECK(translation_error(*T, T_true) < 1e-3);
+    CHECK(rotation_error_deg(*T, T_true) < 1e-3);
+  }
+  SECTION("a subset of 350 (the earlier default near a prior) keeps too few of the scene's matches") {
+    options.ransac_max_points_near_prior = 350;
+    CHECK_FALSE(rgbl::estimate_frame_motion(cam, last, cur, options, prior));
+  }
+  SECTION("without a prior the subset stays at ransac_max_points: too few of the scene's matches") {
+    REQUIRE(options.ransac_max_points == 350);
+    CHECK_FALSE(rgbl::estimate_frame_motion(cam, last, cur, options));
+    options.ransac_max_points = 1000;
+    const auto T = rgbl::estimate_frame_motion(cam, last, cur, options);
+    REQUIRE(T);
+    CHECK(translation_error(*T, T_true) < 1e-3);
+  }
 }

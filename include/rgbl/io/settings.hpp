@@ -27,6 +27,10 @@
 //   direction of travel, default 1),
 //   Tracking.RegisterGaps (0/1, TrackerOptions::register_gaps: the scans registered across a gap),
 //   Tracking.RegisterLost (0/1, TrackerOptions::register_lost: a lost frame placed by its scan),
+//   Tracking.RegisterRefusedSteps (0/1, TrackerOptions::register_refused_steps: a frame whose step was
+//   refused placed by its scan, default 1),
+//   Tracking.RansacPointsNearPrior (TrackerOptions::ransac_max_points_near_prior: keypoints with depth in
+//   the frame-to-frame RANSAC near a constant-velocity prior, default 1000),
 //   LocalMapping.DepthConsistency (0/1, LocalMappingOptions::depth_consistency: a landmark's depth
 //   sigmas scaled by how far its depths disagree with its keyframes' parallax),
 //   LocalMapping.Triangulation (0/1, LocalMappingOptions::triangulation: landmarks triangulated between
@@ -122,6 +126,8 @@ struct Settings {
   std::optional<bool> direction_prior;              // Tracking.DirectionPrior
   std::optional<bool> register_gaps;                // Tracking.RegisterGaps
   std::optional<bool> register_lost;                // Tracking.RegisterLost
+  std::optional<bool> register_refused_steps;       // Tracking.RegisterRefusedSteps
+  std::optional<int> ransac_points_near_prior;      // Tracking.RansacPointsNearPrior
   std::optional<bool> depth_consistency;            // LocalMapping.DepthConsistency
   std::optional<bool> triangulation;                // LocalMapping.Triangulation
   std::vector<std::string> warnings;  // unknown keys, one message each

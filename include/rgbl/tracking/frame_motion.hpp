@@ -18,8 +18,9 @@ namespace rgbl {
 // T_cur_last (maps points of `last`'s camera into `frame`'s) from brute-force matches (ratio test)
 // between keypoints with usable depth and a 3-point RANSAC on their 3-D alignment (Umeyama), refined
 // on the consensus. Uses options.ransac_*: a strided subset of at most ransac_max_points current
-// keypoints, Hamming <= ransac_max_hamming, ratio ransac_ratio, ransac_iterations samples (fixed seed:
-// deterministic), a point agrees within max(ransac_min_tolerance, ransac_relative_tolerance * z).
+// keypoints (ransac_max_points_near_prior with a prior), Hamming <= ransac_max_hamming, ratio
+// ransac_ratio, ransac_iterations samples (fixed seed: deterministic), a point agrees within
+// max(ransac_min_tolerance, ransac_relative_tolerance * z).
 //
 // With a prior (the constant-velocity motion, when trusted) only motions near it count: translation
 // within ransac_prior_translation + ransac_prior_relative * |prior translation| and rotation within

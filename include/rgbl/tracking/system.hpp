@@ -66,6 +66,7 @@ struct TrackResult {
   bool new_map = false;      // tracking was lost and a new map started here (poses anchored at a guess)
   bool jump = false;         // a step beyond a vehicle's reach, taken on strong evidence
   bool step_rejected = false;  // a step beyond a vehicle's reach on weak evidence: weak, at the prediction
+  bool step_registered = false;  // ...placed by its scan's registration onto the last frame's instead
   // the first frame after a gap in the timestamps, its scan registered onto the last frame's
   // (TrackerOptions::register_gaps); gap_registered: the registration was accepted as the prediction
   bool gap = false;

@@ -36,6 +36,7 @@ struct TrackerOutcome {
   // The pose's step from the previous frame exceeded what a vehicle can do (see check_step):
   bool jump = false;           // ...taken on strong evidence (min_jump_inliers) and reported
   bool step_rejected = false;  // ...on weak evidence: the frame is weak, placed at the prediction
+  bool step_registered = false;  // ...or by its scan (TrackerOptions::register_refused_steps)
   // The first frame after a gap in the frames (TrackerOptions::register_gaps): its scan was registered
   // onto the last frame's; gap_registered: accepted, the registration was the prediction.
   bool gap = false;
@@ -96,6 +97,7 @@ class Tracker {
     bool relocalised = false;  // placed against the whole map
     bool jump = false;           // a step beyond a vehicle's reach, taken on strong evidence
     bool step_rejected = false;  // ...on weak evidence: placed at the prediction
+    bool step_registered = false;  // ...or by its scan (TrackerOptions::register_refused_steps)
     int inliers = 0;
     KeyframeId reference;                   // the reference keyframe it leaves
     std::size_t relocalisation_frame = 0;   // the last relocalisation, this frame's if it made one
@@ -127,6 +129,15 @@ class Tracker {
   // A frame the images cannot place: the same registration, from the constant-velocity guess over the
   // time since the last frame (TrackerOptions::register_lost).
   void register_lost(const Frame& frame, PointCloudView scan, Prediction& prediction) const;
+  // The frame's scan registered onto the last frame's from the prediction, with gap_registration's
+  // checks: the frame's pose when accepted. `what` names the frame's case in the log.
+  std::optional<Eigen::Isometry3d> register_onto_last(const Frame& frame, PointCloudView scan,
+                                                      const Prediction& prediction, const char* what) const;
+  // TrackerOptions::register_refused_steps: a frame whose step was refused placed by its scan.
+  // A relocalisation of the frame after a tracked one, beyond a vehicle's reach of the prediction, that
+  // the scans vote against (check_steps; not after a registered gap).
+  bool scans_refuse_relocalisation(const Hypothesis& relocalised, const Prediction& prediction) const;
+  void register_refused_step(Hypothesis& h, PointCloudView scan, const Prediction& prediction) const;
   // A pose after a gap further from the registered prediction than the gap tolerance: the local map
   // searched from the registration instead, else the frame weak at the registered pose.
   Hypothesis gap_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const;
