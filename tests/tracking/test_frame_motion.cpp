@@ -291,10 +291,11 @@ TEST_CASE("road plane: the least-squares plane of the road's returns, the camera
   CHECK_FALSE(rgbl::road_plane(wall, options));
 }
 
-TEST_CASE("frame motion: near a prior every keypoint with depth takes part, so a scene in few matches is found") {
+TEST_CASE("frame motion: near a prior with every keypoint with depth, a scene in few matches is found") {
   // Vehicles hide most of the scene (traffic seed 7 of the simulator): of ~700 keypoints with depth per
   // frame only 40 match the last frame's on the static scene. A strided subset of 350 keeps about half
-  // of those, short of ransac_min_inliers (30), and gives no prediction.
+  // of those, short of ransac_min_inliers (30), and gives no prediction; ransac_max_points_near_prior
+  // 1000 (opt-in) takes them all.
   const rgbl::PinholeCamera cam = rgbl::test::kitti_camera();
   std::mt19937 rng(5);
   Eigen::Isometry3d T_true = Eigen::Isometry3d::Identity();
@@ -327,18 +328,20 @@ TEST_CASE("frame motion: near a prior every keypoint with depth takes part, so a
   prior.translation() += Eigen::Vector3d(0.05, 0.0, 0.08);
   rgbl::TrackerOptions options;
   REQUIRE(options.ransac_min_inliers == 30);
-  SECTION("with the prior every keypoint takes part: the scene's motion, exactly") {
+  REQUIRE(options.ransac_max_points == 350);
+  SECTION("near the prior with every keypoint (Tracking.RansacPointsNearPrior: 1000): the scene's motion, exactly") {
+    options.ransac_max_points_near_prior = 1000;
     const auto T = rgbl::estimate_frame_motion(cam, last, cur, options, prior);
     REQUIRE(T);
     CHECK(translation_error(*T, T_true) < 1e-3);
     CHECK(rotation_error_deg(*T, T_true) < 1e-3);
   }
-  SECTION("a subset of 350 (the earlier default near a prior) keeps too few of the scene's matches") {
-    options.ransac_max_points_near_prior = 350;
+  SECTION("a subset of 350 (the default) keeps too few of the scene's matches: no prediction") {
+    REQUIRE(options.ransac_max_points_near_prior == 350);
     CHECK_FALSE(rgbl::estimate_frame_motion(cam, last, cur, options, prior));
   }
-  SECTION("without a prior the subset stays at ransac_max_points: too few of the scene's matches") {
-    REQUIRE(options.ransac_max_points == 350);
+  SECTION("without a prior the subset is ransac_max_points' however many near a prior") {
+    options.ransac_max_points_near_prior = 1000;
     CHECK_FALSE(rgbl::estimate_frame_motion(cam, last, cur, options));
     options.ransac_max_points = 1000;
     const auto T = rgbl::estimate_frame_motion(cam, last, cur, options);

@@ -30,7 +30,7 @@
 //   Tracking.RegisterRefusedSteps (0/1, TrackerOptions::register_refused_steps: a frame whose step was
 //   refused placed by its scan, default 1),
 //   Tracking.RansacPointsNearPrior (TrackerOptions::ransac_max_points_near_prior: keypoints with depth in
-//   the frame-to-frame RANSAC near a constant-velocity prior, default 1000),
+//   the frame-to-frame RANSAC near a constant-velocity prior, default 350; 1000 takes every one),
 //   LocalMapping.DepthConsistency (0/1, LocalMappingOptions::depth_consistency: a landmark's depth
 //   sigmas scaled by how far its depths disagree with its keyframes' parallax),
 //   LocalMapping.Triangulation (0/1, LocalMappingOptions::triangulation: landmarks triangulated between
