@@ -366,21 +366,26 @@ const Tracker::LidarView* Tracker::lidar_view(std::optional<LidarView>& cache, c
   return cache ? &*cache : nullptr;
 }
 
+bool Tracker::scans_prefer_prediction(std::optional<LidarView>& cache, const Frame& frame,
+                                      const Eigen::Isometry3d& T_cam_world, const Prediction& prediction,
+                                      const char* what) const {
+  const double dt = frame.timestamp - last_frame_->timestamp;
+  const Eigen::Vector3d last_centre = prediction.T_last_world.inverse().translation();
+  if (check_step(T_cam_world, prediction.T_cam_world, last_centre, dt, options_).translation_plausible) return false;
+  return lidar_preference(cache, frame, T_cam_world, prediction.T_cam_world, what, "the prediction", false) > 0;
+}
+
 bool Tracker::scans_refuse_relocalisation(const Hypothesis& relocalised, const Prediction& prediction) const {
   // A relocalisation is not checked as a step is (it may follow a loss), so the frame right after a
-  // tracked one is judged here: a pose beyond a vehicle's reach of the prediction is taken only if the
-  // scans do not prefer the prediction. An image three frames old (04, frame 31 fed frame 28's) was
+  // tracked one is judged here, under the step check's own conditions, by the vote step_hypothesis
+  // asks of the relocalisation it tries. An image three frames old (04, frame 31 fed frame 28's) was
   // relocalised 4.2 m off on 161 inliers and reported ok.
   if (!options_.check_steps || !velocity_steady_ || !has_pose(state_) || !last_frame_ || prediction.registered) {
     return false;
   }
-  const Frame& frame = relocalised.frame;
-  const double dt = frame.timestamp - last_frame_->timestamp;
-  const Eigen::Vector3d last_centre = prediction.T_last_world.inverse().translation();
-  if (check_step(frame.T_cam_world, prediction.T_cam_world, last_centre, dt, options_).translation_plausible) return false;
   std::optional<LidarView> lidar;
-  return lidar_preference(lidar, frame, frame.T_cam_world, prediction.T_cam_world, "the relocalisation",
-                          "the prediction", false) > 0;
+  return scans_prefer_prediction(lidar, relocalised.frame, relocalised.frame.T_cam_world, prediction,
+                                 "the relocalisation");
 }
 
 int Tracker::lidar_preference(std::optional<LidarView>& cache, const Frame& frame, const Eigen::Isometry3d& T_a_world,
@@ -508,15 +513,8 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
     // just refused the step judge it as well (traffic seed 3 at nFeatures 1900 with the ring plane fit,
     // frame 54: the LiDAR voted 1010 to 238 against a 0.74 m step, then a relocalisation beside it on
     // 261 against 255 inliers was taken, and the map was lost six frames later).
-    const auto lidar_refuses_relocalisation = [&] {
-      if (check_step(relocalised.frame.T_cam_world, prediction.T_cam_world, last_centre, dt, options_)
-              .translation_plausible) {
-        return false;
-      }
-      return lidar_preference(lidar, h.frame, relocalised.frame.T_cam_world, prediction.T_cam_world,
-                              "the relocalisation", "the prediction", false) > 0;
-    };
-    if (relocalised.ok && relocalised.inliers > h.inliers && !lidar_refuses_relocalisation()) {
+    if (relocalised.ok && relocalised.inliers > h.inliers &&
+        !scans_prefer_prediction(lidar, h.frame, relocalised.frame.T_cam_world, prediction, "the relocalisation")) {
       logger()->warn("frame {}: step {:.2f} m / {:.1f} deg off the constant-velocity prediction, taken as a "
                      "relocalisation on {} inliers", h.frame.index, step.translation_m, step.rotation_deg,
                      relocalised.inliers);
@@ -604,13 +602,13 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
     state_ = h.weak ? TrackState::Weak : support_state(inliers, frames_since_relocalisation(frame), options_);
     last_ok_frame_ = frame.index;
     last_inliers_ = inliers;
-    if (last_frame_ && h.step_registered) {
-      // the scans measured this motion where the images could not: the velocity from here on
+    // a refused step placed at the prediction keeps the velocity; placed by its scan, the scans
+    // measured the motion where the images could not, and it becomes the velocity
+    if (last_frame_ && (!h.step_rejected || h.step_registered)) {
       velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
       velocity_dt_ = frame.timestamp - last_frame_->timestamp;
-    } else if (last_frame_ && !h.step_rejected) {
-      velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
-      velocity_dt_ = frame.timestamp - last_frame_->timestamp;
+    }
+    if (last_frame_ && !h.step_rejected) {
       velocity_steady_ = consecutive && first.motion_ok && !h.relocalised;
       if (consecutive && !h.relocalised && !h.jump) travel_.add(last_frame_->T_cam_world, frame.T_cam_world, options_);
     }

@@ -134,9 +134,6 @@ class Tracker {
   std::optional<Eigen::Isometry3d> register_onto_last(const Frame& frame, PointCloudView scan,
                                                       const Prediction& prediction, const char* what) const;
   // TrackerOptions::register_refused_steps: a frame whose step was refused placed by its scan.
-  // A relocalisation of the frame after a tracked one, beyond a vehicle's reach of the prediction, that
-  // the scans vote against (check_steps; not after a registered gap).
-  bool scans_refuse_relocalisation(const Hypothesis& relocalised, const Prediction& prediction) const;
   void register_refused_step(Hypothesis& h, PointCloudView scan, const Prediction& prediction) const;
   // A pose after a gap further from the registered prediction than the gap tolerance: the local map
   // searched from the registration instead, else the frame weak at the registered pose.
@@ -162,6 +159,14 @@ class Tracker {
   // as the independent units (ScanVote::object_preference).
   int lidar_preference(std::optional<LidarView>& cache, const Frame& frame, const Eigen::Isometry3d& T_a_world,
                        const Eigen::Isometry3d& T_b_world, const char* a, const char* b, bool by_objects) const;
+  // A pose of the frame beyond a vehicle's reach of the prediction (check_step's translation) whose
+  // scan lands better on the last frame's from the prediction; `what` names the pose in the log.
+  bool scans_prefer_prediction(std::optional<LidarView>& cache, const Frame& frame,
+                               const Eigen::Isometry3d& T_cam_world, const Prediction& prediction,
+                               const char* what) const;
+  // A relocalisation of the frame after a tracked one that the scans vote against (scans_prefer_prediction,
+  // under the step check's conditions: check_steps, a steady velocity, not after a registered gap).
+  bool scans_refuse_relocalisation(const Hypothesis& relocalised, const Prediction& prediction) const;
   // The LiDAR's own start for `frame` (see TrackerOptions::lidar_start_max_speed) as T_cur_last.
   std::optional<Eigen::Isometry3d> lidar_start(std::optional<LidarView>& cache, const Frame& frame) const;
   // A step beyond a vehicle's reach on weak evidence: the local map searched from the prediction
