@@ -428,6 +428,9 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.ransac_points_near_prior = r.integer({"Tracking.RansacPointsNearPrior"});
   if (s.ransac_points_near_prior && *s.ransac_points_near_prior < 3)
     r.fail("Tracking.RansacPointsNearPrior", "at least 3 keypoints (a rigid motion needs 3 points)");
+  s.ransac_points_near_prior_retry = r.integer({"Tracking.RansacPointsNearPriorRetry"});
+  if (s.ransac_points_near_prior_retry && *s.ransac_points_near_prior_retry < 0)
+    r.fail("Tracking.RansacPointsNearPriorRetry", "a number of keypoints >= 0 (0 = no second RANSAC)");
   s.depth_consistency = flag("LocalMapping.DepthConsistency");
   s.triangulation = flag("LocalMapping.Triangulation");
 

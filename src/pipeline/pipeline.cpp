@@ -104,6 +104,9 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.ransac_points_near_prior) {
     p.system.tracker.ransac_max_points_near_prior = static_cast<std::size_t>(*s.ransac_points_near_prior);
   }
+  if (s.ransac_points_near_prior_retry) {
+    p.system.tracker.ransac_max_points_near_prior_retry = static_cast<std::size_t>(*s.ransac_points_near_prior_retry);
+  }
   if (s.depth_consistency) p.system.mapping.depth_consistency = *s.depth_consistency;
   if (s.triangulation) p.system.mapping.triangulation = *s.triangulation;
   if (s.bf || s.th_depth) {

@@ -185,15 +185,14 @@ std::vector<bool> ground_keypoints(const PinholeCamera& camera, const Frame& fra
 // A rival motion needs no more than a minimal sample's support: the local map judges it (tracker).
 constexpr int kMinRivalInliers = 3;
 
-// Why: breaks the feedback of the constant-velocity prediction on periodic or weak texture (fences,
-// grass), where guided matching around a slightly wrong prediction finds matches that confirm it; the
-// prior keeps a rigid object that moves with the camera (a van ahead at the same speed) from taking
-// over when its corners outnumber the static scene's.
-std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& camera, const Frame& last, const Frame& frame,
-                                                       const TrackerOptions& options,
-                                                       const std::optional<Eigen::Isometry3d>& prior,
-                                                       std::vector<bool>* moving,
-                                                       std::optional<RivalMotion>* rival) {
+namespace {
+
+// estimate_frame_motion on a strided subset of at most max_points current keypoints with depth.
+std::optional<Eigen::Isometry3d> estimate_on_subset(const PinholeCamera& camera, const Frame& last, const Frame& frame,
+                                                    const TrackerOptions& options,
+                                                    const std::optional<Eigen::Isometry3d>& prior,
+                                                    std::vector<bool>* moving, std::optional<RivalMotion>* rival,
+                                                    std::size_t max_points) {
   if (rival != nullptr) rival->reset();
   std::vector<Descriptor> last_desc, cur_desc;
   std::vector<Eigen::Vector3d> last_pts, cur_pts;
@@ -218,8 +217,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
   // A strided subset of the current keypoints bounds the cost; near a prior a larger one (options.hpp).
   std::size_t with_depth = 0;
   for (std::size_t i = 0; i < frame.size(); ++i) with_depth += frame.depth_sigma[i] > 0.0F ? 1 : 0;
-  const std::size_t max_points = std::max<std::size_t>(
-      1, prior ? options.ransac_max_points_near_prior : options.ransac_max_points);
+  max_points = std::max<std::size_t>(1, max_points);
   const std::size_t stride = std::max<std::size_t>(1, (with_depth + max_points - 1) / max_points);
   std::size_t seen = 0;
   for (std::size_t i = 0; i < frame.size(); ++i) {
@@ -410,6 +408,30 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     }
   }
   return best.T;
+}
+
+}  // namespace
+
+// Why: breaks the feedback of the constant-velocity prediction on periodic or weak texture (fences,
+// grass), where guided matching around a slightly wrong prediction finds matches that confirm it; the
+// prior keeps a rigid object that moves with the camera (a van ahead at the same speed) from taking
+// over when its corners outnumber the static scene's.
+std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& camera, const Frame& last, const Frame& frame,
+                                                       const TrackerOptions& options,
+                                                       const std::optional<Eigen::Isometry3d>& prior,
+                                                       std::vector<bool>* moving,
+                                                       std::optional<RivalMotion>* rival) {
+  const std::size_t first = prior ? options.ransac_max_points_near_prior : options.ransac_max_points;
+  auto T = estimate_on_subset(camera, last, frame, options, prior, moving, rival, first);
+  // Near a prior only the prior's neighbourhood can win, so when the subset holds too few of the
+  // scene's matches (vehicles hiding most of it) the other keypoints are evidence (options.hpp).
+  if (!T && prior && options.ransac_max_points_near_prior_retry > first) {
+    logger()->debug("frame {}: too few matches near the prior on {} keypoints, again on up to {}", frame.index, first,
+                    options.ransac_max_points_near_prior_retry);
+    T = estimate_on_subset(camera, last, frame, options, prior, moving, rival,
+                           options.ransac_max_points_near_prior_retry);
+  }
+  return T;
 }
 
 }  // namespace rgbl

@@ -294,8 +294,9 @@ TEST_CASE("road plane: the least-squares plane of the road's returns, the camera
 TEST_CASE("frame motion: near a prior with every keypoint with depth, a scene in few matches is found") {
   // Vehicles hide most of the scene (traffic seed 7 of the simulator): of ~700 keypoints with depth per
   // frame only 40 match the last frame's on the static scene. A strided subset of 350 keeps about half
-  // of those, short of ransac_min_inliers (30), and gives no prediction; ransac_max_points_near_prior
-  // 1000 (opt-in) takes them all.
+  // of those, short of ransac_min_inliers (30), and gives no prediction alone; the second RANSAC on up
+  // to 1000 (ransac_max_points_near_prior_retry, opt-in) or ransac_max_points_near_prior 1000 (opt-in,
+  // every frame) takes them all.
   const rgbl::PinholeCamera cam = rgbl::test::kitti_camera();
   std::mt19937 rng(5);
   Eigen::Isometry3d T_true = Eigen::Isometry3d::Identity();
@@ -336,9 +337,23 @@ TEST_CASE("frame motion: near a prior with every keypoint with depth, a scene in
     CHECK(translation_error(*T, T_true) < 1e-3);
     CHECK(rotation_error_deg(*T, T_true) < 1e-3);
   }
-  SECTION("a subset of 350 (the default) keeps too few of the scene's matches: no prediction") {
+  SECTION("a subset of 350 alone (the default: no second RANSAC) keeps too few of the scene's matches: no prediction") {
     REQUIRE(options.ransac_max_points_near_prior == 350);
+    REQUIRE(options.ransac_max_points_near_prior_retry == 0);
     CHECK_FALSE(rgbl::estimate_frame_motion(cam, last, cur, options, prior));
+  }
+  SECTION("the subset of 350 first, every keypoint again when it finds too few (opt-in): the scene's motion, exactly") {
+    options.ransac_max_points_near_prior_retry = 1000;
+    std::vector<bool> moving;
+    const auto T = rgbl::estimate_frame_motion(cam, last, cur, options, prior, &moving);
+    REQUIRE(T);
+    CHECK(translation_error(*T, T_true) < 1e-3);
+    CHECK(rotation_error_deg(*T, T_true) < 1e-3);
+    CHECK(moving.size() == cur.size());
+  }
+  SECTION("the second RANSAC is near a prior only: without one the subset's verdict stands") {
+    options.ransac_max_points_near_prior_retry = 1000;
+    CHECK_FALSE(rgbl::estimate_frame_motion(cam, last, cur, options));
   }
   SECTION("without a prior the subset is ransac_max_points' however many near a prior") {
     options.ransac_max_points_near_prior = 1000;

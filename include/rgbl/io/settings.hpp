@@ -31,6 +31,8 @@
 //   refused placed by its scan, default 1),
 //   Tracking.RansacPointsNearPrior (TrackerOptions::ransac_max_points_near_prior: keypoints with depth in
 //   the frame-to-frame RANSAC near a constant-velocity prior, default 350; 1000 takes every one),
+//   Tracking.RansacPointsNearPriorRetry (TrackerOptions::ransac_max_points_near_prior_retry: keypoints
+//   with depth in a second RANSAC near the prior when the first finds too few, default 0 = none; 1000 opt-in),
 //   LocalMapping.DepthConsistency (0/1, LocalMappingOptions::depth_consistency: a landmark's depth
 //   sigmas scaled by how far its depths disagree with its keyframes' parallax),
 //   LocalMapping.Triangulation (0/1, LocalMappingOptions::triangulation: landmarks triangulated between
@@ -128,6 +130,7 @@ struct Settings {
   std::optional<bool> register_lost;                // Tracking.RegisterLost
   std::optional<bool> register_refused_steps;       // Tracking.RegisterRefusedSteps
   std::optional<int> ransac_points_near_prior;      // Tracking.RansacPointsNearPrior
+  std::optional<int> ransac_points_near_prior_retry;  // Tracking.RansacPointsNearPriorRetry
   std::optional<bool> depth_consistency;            // LocalMapping.DepthConsistency
   std::optional<bool> triangulation;                // LocalMapping.Triangulation
   std::vector<std::string> warnings;  // unknown keys, one message each

@@ -26,6 +26,8 @@ namespace rgbl {
 // within ransac_prior_translation + ransac_prior_relative * |prior translation| and rotation within
 // ransac_prior_rotation_deg. The prior itself, refined on its own consensus, is the first candidate,
 // so a static scene outnumbered by an object moving with the camera is still found.
+// With ransac_max_points_near_prior_retry above that subset's size (opt-in), a prior, and too few
+// agreeing, the RANSAC runs once more on a subset of up to that many.
 // nullopt: fewer than ransac_min_inliers agree (then the caller keeps its own prediction).
 //
 // With `moving` given and a motion found, it is set per keypoint of `frame`: matched points further
