@@ -425,7 +425,10 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
   auto T = estimate_on_subset(camera, last, frame, options, prior, moving, rival, first);
   // Near a prior only the prior's neighbourhood can win, so when the subset holds too few of the
   // scene's matches (vehicles hiding most of it) the other keypoints are evidence (options.hpp).
-  if (!T && prior && options.ransac_max_points_near_prior_retry > first) {
+  // (a subset that already held every keypoint with depth would only repeat itself)
+  const auto with_depth = static_cast<std::size_t>(
+      std::count_if(frame.depth_sigma.begin(), frame.depth_sigma.end(), [](float s) { return s > 0.0F; }));
+  if (!T && prior && options.ransac_max_points_near_prior_retry > first && with_depth > first) {
     logger()->debug("frame {}: too few matches near the prior on {} keypoints, again on up to {}", frame.index, first,
                     options.ransac_max_points_near_prior_retry);
     T = estimate_on_subset(camera, last, frame, options, prior, moving, rival,
