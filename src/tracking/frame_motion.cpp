@@ -187,12 +187,18 @@ constexpr int kMinRivalInliers = 3;
 
 namespace {
 
-// estimate_frame_motion on a strided subset of at most max_points current keypoints with depth.
+// The stride that keeps at most max_points of `with_depth` keypoints (1: every one).
+std::size_t subset_stride(std::size_t with_depth, std::size_t max_points) {
+  max_points = std::max<std::size_t>(1, max_points);
+  return std::max<std::size_t>(1, (with_depth + max_points - 1) / max_points);
+}
+
+// estimate_frame_motion on every stride-th current keypoint with depth.
 std::optional<Eigen::Isometry3d> estimate_on_subset(const PinholeCamera& camera, const Frame& last, const Frame& frame,
                                                     const TrackerOptions& options,
                                                     const std::optional<Eigen::Isometry3d>& prior,
                                                     std::vector<bool>* moving, std::optional<RivalMotion>* rival,
-                                                    std::size_t max_points) {
+                                                    std::size_t stride) {
   if (rival != nullptr) rival->reset();
   std::vector<Descriptor> last_desc, cur_desc;
   std::vector<Eigen::Vector3d> last_pts, cur_pts;
@@ -214,11 +220,6 @@ std::optional<Eigen::Isometry3d> estimate_on_subset(const PinholeCamera& camera,
     const int cy = std::max(0, static_cast<int>(kp.y / cell_size));
     return cy * cells_x + std::min(cx, cells_x - 1);
   };
-  // A strided subset of the current keypoints bounds the cost; near a prior a larger one (options.hpp).
-  std::size_t with_depth = 0;
-  for (std::size_t i = 0; i < frame.size(); ++i) with_depth += frame.depth_sigma[i] > 0.0F ? 1 : 0;
-  max_points = std::max<std::size_t>(1, max_points);
-  const std::size_t stride = std::max<std::size_t>(1, (with_depth + max_points - 1) / max_points);
   std::size_t seen = 0;
   for (std::size_t i = 0; i < frame.size(); ++i) {
     if (frame.depth_sigma[i] <= 0.0F) continue;
@@ -421,18 +422,20 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
                                                        const std::optional<Eigen::Isometry3d>& prior,
                                                        std::vector<bool>* moving,
                                                        std::optional<RivalMotion>* rival) {
-  const std::size_t first = prior ? options.ransac_max_points_near_prior : options.ransac_max_points;
-  auto T = estimate_on_subset(camera, last, frame, options, prior, moving, rival, first);
-  // Near a prior only the prior's neighbourhood can win, so when the subset holds too few of the
-  // scene's matches (vehicles hiding most of it) the other keypoints are evidence (options.hpp).
-  // (a subset that already held every keypoint with depth would only repeat itself)
+  // A strided subset of the current keypoints bounds the cost (options.hpp).
   const auto with_depth = static_cast<std::size_t>(
       std::count_if(frame.depth_sigma.begin(), frame.depth_sigma.end(), [](float s) { return s > 0.0F; }));
-  if (!T && prior && options.ransac_max_points_near_prior_retry > first && with_depth > first) {
-    logger()->debug("frame {}: too few matches near the prior on {} keypoints, again on up to {}", frame.index, first,
-                    options.ransac_max_points_near_prior_retry);
-    T = estimate_on_subset(camera, last, frame, options, prior, moving, rival,
-                           options.ransac_max_points_near_prior_retry);
+  const std::size_t first =
+      subset_stride(with_depth, prior ? options.ransac_max_points_near_prior : options.ransac_max_points);
+  auto T = estimate_on_subset(camera, last, frame, options, prior, moving, rival, first);
+  // Near a prior only the prior's neighbourhood can win, so when the subset holds too few of the
+  // scene's matches (vehicles hiding most of it) the other keypoints are evidence; a retry whose
+  // subset is no larger would only repeat the first.
+  const std::size_t retry = subset_stride(with_depth, options.ransac_max_points_near_prior_retry);
+  if (!T && prior && options.ransac_max_points_near_prior_retry > 0 && retry < first) {
+    logger()->debug("frame {}: too few matches near the prior on the subset of stride {}, again with stride {}",
+                    frame.index, first, retry);
+    T = estimate_on_subset(camera, last, frame, options, prior, moving, rival, retry);
   }
   return T;
 }

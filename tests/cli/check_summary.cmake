@@ -1,0 +1,22 @@
+# check_summary(text): sets `failure` to why a run's printed summary misses the bounds (empty: it meets
+# them): every one of FRAMES frames tracked, at most MAX_WEAK weak, ATE <= MAX_ATE m (set by the caller).
+function(check_summary text)
+  set(failure "" PARENT_SCOPE)
+  if(NOT text MATCHES "ok ([0-9]+), weak ([0-9]+), lost 0, not initialised 0")
+    set(failure "a frame lost or not initialised" PARENT_SCOPE)
+    return()
+  endif()
+  math(EXPR tracked "${CMAKE_MATCH_1} + ${CMAKE_MATCH_2}")
+  if(NOT tracked EQUAL FRAMES OR CMAKE_MATCH_2 GREATER MAX_WEAK)
+    set(failure "${CMAKE_MATCH_1} frames ok and ${CMAKE_MATCH_2} weak of ${FRAMES}: at most ${MAX_WEAK} may be weak"
+        PARENT_SCOPE)
+    return()
+  endif()
+  if(NOT text MATCHES "ATE RMSE ([0-9]+\\.[0-9]+) m")
+    set(failure "no ATE against the ground truth in the summary" PARENT_SCOPE)
+    return()
+  endif()
+  if(CMAKE_MATCH_1 GREATER MAX_ATE)
+    set(failure "ATE ${CMAKE_MATCH_1} m above the bound ${MAX_ATE} m" PARENT_SCOPE)
+  endif()
+endfunction()
