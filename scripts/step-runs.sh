@@ -5,7 +5,10 @@
 # are judged on these runs too (docs/accuracy.md).
 #
 #   scripts/step-runs.sh --a BUILD_DIR --b BUILD_DIR [--out DIR] [--steps "2 3 ..."] [--firsts "0 3"]
+#                        [--a-config FILE] [--b-config FILE]
 #
+# --a-config / --b-config: a settings YAML passed as `rgbl run --config` to that side's runs, so one
+# build can be compared with itself under another option (the same build for --a and --b).
 # Real data from $RGBL_DATA (default ../shared/data); prints "skipped: no data" without it.
 set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -14,6 +17,8 @@ b=""
 out="$repo/build/step-runs"
 steps="2 3 4 5 6 7 8 9 10 11 12"
 firsts="0 3"
+a_config=""
+b_config=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --a) a="$2"; shift 2 ;;
@@ -21,13 +26,18 @@ while [ $# -gt 0 ]; do
     --out) out="$2"; shift 2 ;;
     --steps) steps="$2"; shift 2 ;;
     --firsts) firsts="$2"; shift 2 ;;
-    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
+    --a-config) a_config="$2"; shift 2 ;;
+    --b-config) b_config="$2"; shift 2 ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
     *) echo "step-runs: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
 [ -n "$a" ] && [ -n "$b" ] || { echo "step-runs: give both builds, --a DIR --b DIR" >&2; exit 2; }
 for build in "$a" "$b"; do
   [ -x "$build/bin/rgbl" ] || { echo "step-runs: $build/bin/rgbl not built" >&2; exit 2; }
+done
+for f in "$a_config" "$b_config"; do
+  [ -z "$f" ] || [ -r "$f" ] || { echo "step-runs: cannot read the settings file '$f'" >&2; exit 2; }
 done
 data="${RGBL_DATA:-$repo/../shared/data}"
 [ -d "$data/kitti" ] || { echo "skipped: no data ($data/kitti absent; set RGBL_DATA)"; exit 0; }
@@ -49,9 +59,12 @@ for drive in "${drives[@]}"; do
       run="$name-first$first-step$step"
       for side in a b; do
         build="$a"
-        [ "$side" = b ] && build="$b"
+        config="$a_config"
+        [ "$side" = b ] && build="$b" && config="$b_config"
+        extra=()
+        [ -z "$config" ] || extra=(--config "$config")
         rm -rf "$out/$side/$run"
-        "$build/bin/rgbl" -q run "$drive" --first "$first" --step "$step" --out "$out/$side/$run" \
+        "$build/bin/rgbl" -q run "$drive" --first "$first" --step "$step" --out "$out/$side/$run" "${extra[@]}" \
             > "$out/$side-$run.log" 2>&1 || true
       done
       same="differ"
