@@ -77,7 +77,8 @@ void bind_eval(py::module_& m) {
 
   py::class_<TrajectoryEvaluation>(m, "TrajectoryEvaluation", "Every metric at once, as `rgbl run` reports them.")
       .def_readonly("poses", &TrajectoryEvaluation::poses)
-      .def_readonly("path_length", &TrajectoryEvaluation::path_length)
+      .def_readonly("path_length", &TrajectoryEvaluation::path_length, "m, ground truth")
+      .def_readonly("estimated_path_length", &TrajectoryEvaluation::estimated_path_length, "m, the estimate's own")
       .def_readonly("kitti_options", &TrajectoryEvaluation::kitti_options)
       .def_readonly("kitti", &TrajectoryEvaluation::kitti)
       .def_readonly("ate", &TrajectoryEvaluation::ate)

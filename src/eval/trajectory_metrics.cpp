@@ -205,6 +205,7 @@ TrajectoryEvaluation evaluate_trajectory(std::span<const Eigen::Isometry3d> esti
   e.poses = estimate.size();
   e.drift = end_point_drift(estimate, ground_truth);
   e.path_length = e.drift.path_length;
+  e.estimated_path_length = trajectory_distances(estimate).back();
   e.kitti_options = kitti ? *kitti : kitti_options_for_path(e.path_length);
   e.kitti = kitti_metric(estimate, ground_truth, e.kitti_options);
   e.ate = absolute_trajectory_error(estimate, ground_truth);

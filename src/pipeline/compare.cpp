@@ -164,6 +164,7 @@ std::string comparison_json(const TrajectoryComparison& c) {
                      {"format", c.format},
                      {"poses", e.poses},
                      {"path_length_m", json_number(e.path_length)},
+                     {"estimated_path_length_m", json_number(e.estimated_path_length)},
                      {"kitti",
                       {{"lengths_m", e.kitti_options.lengths},
                        {"step_frames", e.kitti_options.step_size},
@@ -188,7 +189,8 @@ std::string comparison_text(const TrajectoryComparison& c) {
   fmt::format_to(out, "estimate:      {} ({}, {} poses)\n", c.estimate.string(), c.format, c.estimated_poses);
   fmt::format_to(out, "ground truth:  {} ({})\n", c.ground_truth.string(), c.format);
   for (const auto& note : c.notes) fmt::format_to(out, "note:          {}\n", note);
-  fmt::format_to(out, "path length:   {:.3f} m\n\n", e.path_length);
+  fmt::format_to(out, "path length:   {:.3f} m (ground truth); the estimate's {:.3f} m\n\n", e.path_length,
+                 e.estimated_path_length);
   fmt::format_to(out, "KITTI odometry metric (devkit definition: a segment every {} frames, mean over all segments)\n",
                  e.kitti_options.step_size);
   fmt::format_to(out, "  {:>10}  {:>8}  {:>10}  {:>16}\n", "length [m]", "segments", "t_err [%]", "r_err [deg/100m]");

@@ -59,7 +59,8 @@ Json metrics_json(const RunMetrics& m) {
   return {{"frames_with_ground_truth", m.frames_with_ground_truth},
           {"frames_tracked", m.frames_tracked},
           {"tracked", tracked},  // ATE over the tracked frames alone; the figures below cover every frame
-          {"path_length_m", json_number(e.path_length)},
+          {"path_length_m", json_number(e.path_length)},  // the ground truth's
+          {"estimated_path_length_m", json_number(e.estimated_path_length)},
           {"ate_rmse_m", json_number(e.ate.translation.rmse)},
           {"ate_max_m", json_number(e.ate.translation.max)},
           {"end_point_drift_m", json_number(e.drift.end_error)},
@@ -171,6 +172,8 @@ std::string summary_json(const RunResult& run) {
   j["rejected_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_rejected; });
   // ...of those, the ones placed by their scan's registration onto the last frame's
   j["registered_rejected_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_registered; });
+  // steps refused although clearly more inliers agreed with them than with the pose kept (weak frames)
+  j["contested_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_contested; });
   // first frames after a gap in the timestamps whose scan was registered across it, and those where
   // the registration was accepted as the prediction
   j["gap_frames"] = run.frames_where([](const TrackResult& r) { return r.gap; });
@@ -278,6 +281,8 @@ std::string summary_text(const RunResult& run) {
   fmt::format_to(out, "  ATE RMSE {:.3f} m, end-point drift {:.2f} %, KITTI metric ({}) {:.2f} % / {:.3f} deg/100m\n",
                  e.ate.translation.rmse, e.drift.percent, m.kitti_lengths, e.kitti.t_err_percent,
                  e.kitti.r_err_deg_per_100m);
+  // a path far shorter than the truth's: tracking stood still on something moving with the car
+  fmt::format_to(out, "  path {:.1f} m, the ground truth's {:.1f} m\n", e.estimated_path_length, e.path_length);
   return s;
 }
 

@@ -78,6 +78,17 @@ TEST_CASE("KITTI metric: a 2 % scale error on a straight line", "[eval][kitti]")
   CHECK(rpe.rotation_deg.max == 0.0);
 }
 
+TEST_CASE("evaluation: the estimate's own path length beside the ground truth's", "[eval]") {
+  // standing still while the car drives 10 m: the sign of a start locked on vehicles at the ego speed
+  const Poses gt = straight_line(11);
+  const Poses standing(11, Eigen::Isometry3d::Identity());
+  const auto e = rgbl::evaluate_trajectory(standing, gt);
+  CHECK_THAT(e.path_length, WithinAbs(10.0, 1e-12));
+  CHECK_THAT(e.estimated_path_length, WithinAbs(0.0, 1e-12));
+  const auto scaled = rgbl::evaluate_trajectory(straight_line(11, 1.02), gt);
+  CHECK_THAT(scaled.estimated_path_length, WithinAbs(10.2, 1e-9));
+}
+
 TEST_CASE("KITTI metric: a constant yaw-rate error", "[eval][kitti]") {
   const double yaw = 1e-4;  // rad per metre
   const Poses gt = straight_line(301);

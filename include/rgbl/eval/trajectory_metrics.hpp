@@ -101,6 +101,8 @@ std::string describe_lengths(const KittiMetricOptions& options);
 struct TrajectoryEvaluation {
   std::size_t poses = 0;
   double path_length = 0.0;  // m, ground truth
+  // m, the estimate's own: far below path_length when tracking stood still while the car drove
+  double estimated_path_length = 0.0;
   KittiMetricOptions kitti_options;
   KittiMetric kitti;
   AteResult ate;
