@@ -14,6 +14,8 @@
 # run here; with --plain each length and seed's plain street once more.
 set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# shellcheck source=lib/scenario-cache.sh
+source "$repo/scripts/lib/scenario-cache.sh"  # scenario_length
 build="$repo/build/release"
 scenarios="lead-vehicle traffic foliage shadows turn repeated suburban"
 seeds="13 14 15 16 17 18 19 20"
@@ -37,28 +39,23 @@ done
 extra=()
 [ -z "$config" ] || extra=(--config "$config")
 mkdir -p "$out"
-# run folder -> "ATE lost weak path/truth", or "failed - - -"; the paths are summed from the KITTI
-# trajectory files (summary.json's path_length_m is the truth's alone)
+# run folder -> "ATE lost weak path/truth", or "failed - - -" (summary.json's metrics: the estimate's
+# path length over the ground truth's)
 read_run() {
   [ -f "$1/summary.json" ] || { echo "failed - - -"; return; }
-  python3 - "$1" << 'EOF'
-import json, math, sys
-run = sys.argv[1]
-s = json.load(open(f"{run}/summary.json"))
-def length(name):
-    centres = [[float(v) for v in line.split()[-12:]][3::4] for line in open(f"{run}/{name}") if line.strip()]
-    return sum(math.dist(a, b) for a, b in zip(centres, centres[1:]))
-truth = length("ground_truth_kitti.txt")
-ratio = f"{length('trajectory_kitti.txt') / truth:.3f}" if truth > 0 else "-"
-print(f"{s['metrics']['ate_rmse_m']:.3f} {s['lost']} {s['weak']} {ratio}")
+  python3 - "$1/summary.json" << 'EOF'
+import json, sys
+s = json.load(open(sys.argv[1]))
+m = s["metrics"]
+ratio = f"{m['estimated_path_length_m'] / m['path_length_m']:.3f}" if m["path_length_m"] > 0 else "-"
+print(f"{m['ate_rmse_m']:.3f} {s['lost']} {s['weak']} {ratio}")
 EOF
 }
+listing="$("$build/bin/rgbl" demo --scenario list 2> /dev/null)"
 printf '%-22s %8s %5s %5s %11s %10s %7s\n' "run" "ATE m" "lost" "weak" "path/truth" "plain ATE" "x plain"
 declare -A plain_ates  # "frames seed" -> the plain street's ATE: each rendered and tracked once
 for scenario in $scenarios; do
-  # the scenario's own length, as `rgbl demo --scenario list` prints it
-  frames="$("$build/bin/rgbl" demo --scenario list 2> /dev/null | awk -v s="$scenario" '$1 == s' |
-      grep -o 'default [0-9]* frames' | awk '{print $2}')"
+  frames="$(scenario_length "$listing" "$scenario")"  # its own default length
   for seed in $seeds; do
     run="$scenario-s$seed"
     "$build/bin/rgbl" -q demo --scenario "$scenario" --seed "$seed" --out "$out/$run" "${extra[@]}" \
