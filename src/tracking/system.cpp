@@ -386,6 +386,7 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   result.jump = outcome.jump;
   result.step_rejected = outcome.step_rejected;
   result.step_registered = outcome.step_registered;
+  result.step_contested = outcome.step_contested;
   result.gap = outcome.gap;
   result.gap_registered = outcome.gap_registered;
   result.lost_registered = outcome.lost_registered;

@@ -1,0 +1,57 @@
+# A traffic street (80 frames, seed SEED) rendered by `rgbl demo` and tracked again by `rgbl run` with
+# SETTINGS (settings-file lines, separated by ';', may be empty): every frame tracked (none lost), ATE
+# <= MAX_ATE metres and, with EXPECT, the run's summary matching that regular expression. With
+# MIN_FLAGGED instead: the run may end beyond MAX_ATE, and frames may be lost, but then at least
+# MIN_FLAGGED frames must say so (weak or lost): never far off silently. The cases (tests/cli/CMakeLists.txt):
+# - Seed 3, nFeatures 1900 and the ring plane fit (LiDAR.SurfaceFitWindowDeg 0.5): at frame 54 the scans
+#   refuse a 0.74 m step, and the relocalisation asked next lands beside it. Taken on 261 against 255
+#   inliers it lost the map at frame 61 (ATE 4.96 m); the LiDAR's vote on it keeps the prediction (ATE 0.096 m).
+# - Seed 3, nFeatures 1900 and Tracking.RansacPointsNearPrior 1000: standing at the lights, frame 52 is
+#   pulled 0.2 m by the crossing traffic and frames 53-55 are refused. Placed at the constant velocity's
+#   prediction they went on 0.2 m a frame, frame 56 was taken 0.42 m off and the run went (ATE 6.47 m);
+#   placed by their scans (Tracking.RegisterRefusedSteps, default on) the car stands (ATE 0.062 m;
+#   docs/accuracy.md, "Every keypoint with depth near the prior").
+# - Seed 27, defaults: frame 1 is placed against the reference keyframe at the true 1.0 m; frame 2, its
+#   velocity not yet a prior, went to the trucks alongside at the ego speed (standing still, the rest of
+#   the run too: ATE 7.52 m). A velocity from two consecutive tracked frames is now the prior (0.025 m).
+# - Seed 13, defaults: the map starts locked on the trucks on both sides (frame 1 standing still, the
+#   truth 1.0 m ahead; docs/accuracy.md, "Traffic on seeds 13-30"), and every later true step is refused
+#   as beyond reach (ATE 9.9 m), every frame ok but 3 lost. Where clearly more inliers agree with the
+#   refused step than with the prediction (frames 5-8, 18-21, 27, 30) the frames are weak, not ok.
+set(FRAMES 80)
+set(MAX_WEAK ${FRAMES})  # weak frames allowed, as long as none is lost
+if(NOT DEFINED SEED)
+  set(SEED 3)
+endif()
+include(${CMAKE_CURRENT_LIST_DIR}/check_summary.cmake)
+file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${WORK_DIR})
+execute_process(COMMAND ${RGBL} -q demo --scenario traffic --frames ${FRAMES} --seed ${SEED} --keep ${WORK_DIR}/street
+                        --out ${WORK_DIR}/demo
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "rgbl demo failed with exit code ${rc}: ${out}${err}")
+endif()
+set(config "")
+if(SETTINGS)
+  string(REPLACE ";" "\n" lines "${SETTINGS}")
+  file(WRITE ${WORK_DIR}/settings.yaml "%YAML:1.0\n${lines}\n")
+  set(config --config ${WORK_DIR}/settings.yaml)
+endif()
+execute_process(COMMAND ${RGBL} run ${WORK_DIR}/street/sequences/00 ${config} --out ${WORK_DIR}/out
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}${err}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "rgbl run failed with exit code ${rc}")
+endif()
+if(DEFINED EXPECT AND NOT out MATCHES "${EXPECT}")
+  message(FATAL_ERROR "the summary does not say '${EXPECT}'")
+endif()
+if(DEFINED MIN_FLAGGED)
+  check_flagged("${out}")
+else()
+  check_summary("${out}")
+endif()
+if(failure)
+  message(FATAL_ERROR "${failure}")
+endif()
