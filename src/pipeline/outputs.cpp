@@ -239,6 +239,11 @@ std::string summary_text(const RunResult& run) {
     fmt::format_to(out, "  refused step(s) placed by the scans (not the constant-velocity guess): {}\n",
                    fmt::join(refused, ", "));
   }
+  const auto contested = run.frames_where([](const TrackResult& r) { return r.step_contested; });
+  if (!contested.empty()) {
+    fmt::format_to(out, "  frame(s) placed against clearly more support for another pose (weak): {}\n",
+                   fmt::join(contested, ", "));
+  }
   const auto placed = run.frames_where([](const TrackResult& r) { return r.lost_registered; });
   if (!placed.empty()) {
     fmt::format_to(out, "  lost frame(s) placed by the scans (not the constant-velocity guess): {}\n", fmt::join(placed, ", "));

@@ -18,6 +18,9 @@
 #   truth 1.0 m ahead; docs/accuracy.md, "Traffic on seeds 13-30"), and every later true step is refused
 #   as beyond reach (ATE 9.9 m), every frame ok but 3 lost. Where clearly more inliers agree with the
 #   refused step than with the prediction (frames 5-8, 18-21, 27, 30) the frames are weak, not ok.
+# - Seed 23, defaults: at frame 1 the road picks a start 2.8 m sideways (lane lines repeat across the
+#   lanes: 18 of its 38 inliers on the road) over the true 1.0 m (165, 5 on the road); the run ends
+#   0.33 m off. The start is contested: frame 1 is weak, and the summary names it.
 set(FRAMES 80)
 set(MAX_WEAK ${FRAMES})  # weak frames allowed, as long as none is lost
 if(NOT DEFINED SEED)

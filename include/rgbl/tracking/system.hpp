@@ -68,7 +68,7 @@ struct TrackResult {
   bool step_rejected = false;  // a step beyond a vehicle's reach on weak evidence: weak, at the prediction
   bool step_registered = false;  // ...placed by its scan's registration onto the last frame's instead
   // a step beyond a vehicle's reach refused although clearly more inliers (two sigmas) agree with it
-  // than with the pose kept: weak
+  // than with the pose kept, or a start chosen (by the road or the scans) against clearly more: weak
   bool step_contested = false;
   // the first frame after a gap in the timestamps, its scan registered onto the last frame's
   // (TrackerOptions::register_gaps); gap_registered: the registration was accepted as the prediction

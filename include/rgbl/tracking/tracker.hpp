@@ -38,7 +38,9 @@ struct TrackerOutcome {
   bool step_rejected = false;  // ...on weak evidence: the frame is weak, placed at the prediction
   bool step_registered = false;  // ...or by its scan (TrackerOptions::register_refused_steps)
   // ...or the step was refused although clearly more local-map inliers (two sigmas) agree with it than
-  // with the pose kept: the frame is weak (the evidence contradicts its pose)
+  // with the pose kept: the frame is weak (the evidence contradicts its pose). Also set for a start
+  // against the reference keyframe chosen (by the road or the scans) over another start beyond a
+  // step's tolerance with clearly more local-map inliers.
   bool step_contested = false;
   // The first frame after a gap in the frames (TrackerOptions::register_gaps): its scan was registered
   // onto the last frame's; gap_registered: accepted, the registration was the prediction.
@@ -101,8 +103,8 @@ class Tracker {
     bool jump = false;           // a step beyond a vehicle's reach, taken on strong evidence
     bool step_rejected = false;  // ...on weak evidence: placed at the prediction
     bool step_registered = false;  // ...or by its scan (TrackerOptions::register_refused_steps)
-    // a step beyond reach refused for the prediction's pose though clearly more inliers agree with it:
-    // weak, but no keyframe for it (the frame adds nothing the map lacks, its pose is the one in doubt)
+    // a step beyond reach refused for the prediction's pose though clearly more inliers agree with it,
+    // or a start chosen against clearly more: weak, but no keyframe for it (its pose is the one in doubt)
     bool step_contested = false;
     int inliers = 0;
     KeyframeId reference;                   // the reference keyframe it leaves
