@@ -425,6 +425,9 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.register_gaps = flag("Tracking.RegisterGaps");
   s.register_lost = flag("Tracking.RegisterLost");
   s.register_refused_steps = flag("Tracking.RegisterRefusedSteps");
+  s.start_doubt_s = r.number({"Tracking.StartDoubt"});
+  if (s.start_doubt_s && !(*s.start_doubt_s >= 0.0 && *s.start_doubt_s <= 60.0))
+    r.fail("Tracking.StartDoubt", "seconds from 0 (off) to 60");
   s.ransac_points_near_prior = r.integer({"Tracking.RansacPointsNearPrior"});
   if (s.ransac_points_near_prior && *s.ransac_points_near_prior < 3)
     r.fail("Tracking.RansacPointsNearPrior", "at least 3 keypoints (a rigid motion needs 3 points)");

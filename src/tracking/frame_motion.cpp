@@ -440,4 +440,40 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
   return T;
 }
 
+RayFits fits_by_rays(const PinholeCamera& camera, const Frame& last, const Frame& frame, const Eigen::Isometry3d& T_a,
+                     const Eigen::Isometry3d& T_b, int max_hamming) {
+  std::vector<std::size_t> rows;  // last's keypoints without depth
+  std::vector<Descriptor> query;
+  for (std::size_t i = 0; i < last.size(); ++i) {
+    if (last.depth[i] > 0.0F) continue;
+    rows.push_back(i);
+    query.push_back(last.descriptors[i]);
+  }
+  const auto fits = [&](const Eigen::Isometry3d& T, const Eigen::Vector3d& ray, const Keypoint& k) {
+    const Eigen::Vector3d p_near = T * (ray * (2.0 + 1.5 * T.translation().norm()));
+    const Eigen::Vector3d at_infinity = T.linear() * ray;  // a direction: its image is the far end
+    if (p_near.z() <= 1e-3 || at_infinity.z() <= 1e-3) return false;
+    const Eigen::Vector2d a = camera.project_unchecked(p_near);
+    const Eigen::Vector2d b = camera.project_unchecked(at_infinity);
+    const Eigen::Vector2d px(k.x, k.y);
+    const Eigen::Vector2d ab = b - a;
+    const double length2 = ab.squaredNorm();
+    const double s = length2 > 0.0 ? std::clamp((px - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+    return (a + s * ab - px).norm() <= 2.0 * std::pow(1.2, k.level);
+  };
+  RayFits result;
+  for (const auto& [q, t] : detail::match_brute_force(query, frame.descriptors, max_hamming, 0.8)) {
+    const Keypoint& k_last = last.keypoints[rows[static_cast<std::size_t>(q)]];
+    const Eigen::Vector3d ray = camera.unproject(Eigen::Vector2d(k_last.x, k_last.y), 1.0);  // z = 1
+    const Keypoint& k = frame.keypoints[static_cast<std::size_t>(t)];
+    const bool on_a = fits(T_a, ray, k);
+    const bool on_b = fits(T_b, ray, k);
+    ++result.matches;
+    result.a_only += on_a && !on_b ? 1 : 0;
+    result.b_only += on_b && !on_a ? 1 : 0;
+  }
+  return result;
+}
+
+
 }  // namespace rgbl

@@ -17,7 +17,10 @@
 # - Seed 13, defaults: the map starts locked on the trucks on both sides (frame 1 standing still, the
 #   truth 1.0 m ahead; docs/accuracy.md, "Traffic on seeds 13-30"), and every later true step is refused
 #   as beyond reach (ATE 9.9 m), every frame ok but 3 lost. Where clearly more inliers agree with the
-#   refused step than with the prediction (frames 5-8, 18-21, 27, 30) the frames are weak, not ok.
+#   refused step than with the prediction (frames 5-8, 18-21, 27, 30) the frames are weak, not ok
+#   (Tracking.StartDoubt: 0). By default the start is in doubt for its first second: at frame 5 the
+#   keypoints without depth fit the contested step alone 57 times, the prediction 5, and the step is
+#   taken (weak, ATE 0.64 m: frames 1-4 stay where the wrong start put them).
 # - Seed 23, defaults: at frame 1 the road picks a start 2.8 m sideways (lane lines repeat across the
 #   lanes: 18 of its 38 inliers on the road) over the true 1.0 m (165, 5 on the road); the run ends
 #   0.33 m off. The start is contested: frame 1 is weak, and the summary names it.

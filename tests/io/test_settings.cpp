@@ -266,13 +266,13 @@ TEST_CASE("settings: the LiDAR pair's sigmas and the scan samples' elevation cor
   }
 }
 
-TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, RegisterGaps, CauchyWeights, ObjectTest, DirectionPrior, RegisterRefusedSteps, RansacPointsNearPrior(Retry), LocalMapping.DepthConsistency and Triangulation, read and validated", "[io][settings]") {
+TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, RegisterGaps, CauchyWeights, ObjectTest, DirectionPrior, RegisterRefusedSteps, StartDoubt, RansacPointsNearPrior(Retry), LocalMapping.DepthConsistency and Triangulation, read and validated", "[io][settings]") {
   rgbl::test::TempDir tmp;
   const auto s = rgbl::read_settings(tmp.write(
       "t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0.25\nTracking.BoundedDepthError: 1\nTracking.RegisterGaps: 0\n"
                 "Tracking.CauchyWeights: 0\nTracking.ObjectTest: 1\nTracking.DirectionPrior: 0\n"
                 "Tracking.RegisterRefusedSteps: 0\nTracking.RansacPointsNearPrior: 500\n"
-                "Tracking.RansacPointsNearPriorRetry: 0\n"
+                "Tracking.RansacPointsNearPriorRetry: 0\nTracking.StartDoubt: 0.5\n"
                 "LocalMapping.DepthConsistency: 1\nLocalMapping.Triangulation: 1\n"));
   REQUIRE(s.reference_landmark_ratio);
   CHECK(*s.reference_landmark_ratio == 0.25);
@@ -286,6 +286,7 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK(s.register_refused_steps == false);
   CHECK(s.ransac_points_near_prior == 500);
   CHECK(s.ransac_points_near_prior_retry == 0);
+  CHECK(s.start_doubt_s == 0.5);
   CHECK(s.warnings.empty());
   const auto unset = rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n"));
   CHECK_FALSE(unset.reference_landmark_ratio);
@@ -299,6 +300,9 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK_FALSE(unset.register_refused_steps);
   CHECK_FALSE(unset.ransac_points_near_prior);
   CHECK_FALSE(unset.ransac_points_near_prior_retry);
+  CHECK_FALSE(unset.start_doubt_s);
+  CHECK_THAT(error_of(tmp.write("doubt.yaml", "%YAML:1.0\nTracking.StartDoubt: -1\n")),
+             Contains("'Tracking.StartDoubt': expected seconds from 0 (off) to 60"));
   CHECK_THAT(error_of(tmp.write("refused.yaml", "%YAML:1.0\nTracking.RegisterRefusedSteps: 2\n")),
              Contains("'Tracking.RegisterRefusedSteps': expected 0 (off) or 1 (on)"));
   CHECK_THAT(error_of(tmp.write("points.yaml", "%YAML:1.0\nTracking.RansacPointsNearPrior: 2\n")),

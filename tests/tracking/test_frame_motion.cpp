@@ -364,3 +364,39 @@ TEST_CASE("frame motion: near a prior with every keypoint with depth, a scene in
     CHECK(translation_error(*T, T_true) < 1e-3);
   }
 }
+
+TEST_CASE("rays without depth: the scene beyond the LiDAR tells a driving camera from one standing among vehicles") {
+  const rgbl::PinholeCamera cam = rgbl::test::kitti_camera();
+  std::mt19937 rng(5);
+  // The car drives 1.0 m forward. Without depth: 150 facade points 10-40 m ahead on both sides, 60
+  // points on a truck's top alongside that moves with the car (they stay put in the image), 30 points
+  // near infinity (they fit any translation).
+  Eigen::Isometry3d T_drive = Eigen::Isometry3d::Identity();
+  T_drive.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);
+  Eigen::Isometry3d T_side = Eigen::Isometry3d::Identity();
+  T_side.translation() = Eigen::Vector3d(1.0, 0.0, 0.0);
+  const Eigen::Isometry3d T_stand = Eigen::Isometry3d::Identity();
+  Scene s;
+  add_points(s, rng, 75, {-14.0, -6.0, 10.0}, {-7.0, -1.0, 40.0}, T_drive);
+  add_points(s, rng, 75, {7.0, -6.0, 10.0}, {14.0, -1.0, 40.0}, T_drive);
+  add_points(s, rng, 60, {2.5, -3.5, 6.0}, {4.0, -2.5, 14.0}, T_stand);
+  add_points(s, rng, 30, {-400.0, -200.0, 3000.0}, {400.0, -50.0, 4000.0}, T_drive);
+  auto [last, cur] = frames_of(s, cam, rng);
+  std::fill(last.depth.begin(), last.depth.end(), 0.0F);
+  std::fill(last.depth_sigma.begin(), last.depth_sigma.end(), 0.0F);
+
+  const rgbl::RayFits drive_or_stand = rgbl::fits_by_rays(cam, last, cur, T_drive, T_stand, 100);
+  CHECK(drive_or_stand.matches == 240);
+  CHECK(drive_or_stand.a_only >= 140);  // the facades' parallax; the truck and the far points fit both
+  CHECK(drive_or_stand.b_only == 0);
+  const rgbl::RayFits stand_or_drive = rgbl::fits_by_rays(cam, last, cur, T_stand, T_drive, 100);
+  CHECK(stand_or_drive.a_only == drive_or_stand.b_only);
+  CHECK(stand_or_drive.b_only == drive_or_stand.a_only);
+  // sideways is no forward step either: the facades fit the true motion alone
+  const rgbl::RayFits drive_or_side = rgbl::fits_by_rays(cam, last, cur, T_drive, T_side, 100);
+  CHECK(drive_or_side.a_only >= 120);
+  CHECK(drive_or_side.b_only <= 5);
+  // keypoints with depth are not asked: the LiDAR decides those
+  std::fill(last.depth.begin(), last.depth.end(), 12.0F);
+  CHECK(rgbl::fits_by_rays(cam, last, cur, T_drive, T_stand, 100).matches == 0);
+}

@@ -123,6 +123,9 @@ TEST_CASE("support: the thresholds are validated", "[tracking][support]") {
   options.step_tolerance_rotation_deg = -1.0;
   CHECK_THROWS_WITH(options.validate(), Catch::Contains("tracker.step_tolerance_rotation_deg"));
   options = {};
+  options.start_doubt_s = -0.5;
+  CHECK_THROWS_WITH(options.validate(), Catch::Contains("tracker.start_doubt_s"));
+  options = {};
   options.max_acceleration = -1.0;
   CHECK_THROWS_WITH(options.validate(), Catch::Contains("tracker.max_acceleration"));
   CHECK_NOTHROW(rgbl::TrackerOptions{}.validate());

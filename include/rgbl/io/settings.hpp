@@ -29,6 +29,8 @@
 //   Tracking.RegisterLost (0/1, TrackerOptions::register_lost: a lost frame placed by its scan),
 //   Tracking.RegisterRefusedSteps (0/1, TrackerOptions::register_refused_steps: a frame whose step was
 //   refused placed by its scan, default 1),
+//   Tracking.StartDoubt (TrackerOptions::start_doubt_s: seconds after a start without velocity in which
+//   a contested step is taken when the keypoints without depth favour it, default 1, 0 = off),
 //   Tracking.RansacPointsNearPrior (TrackerOptions::ransac_max_points_near_prior: keypoints with depth in
 //   the frame-to-frame RANSAC near a constant-velocity prior, default 350; 1000 takes every one),
 //   Tracking.RansacPointsNearPriorRetry (TrackerOptions::ransac_max_points_near_prior_retry: keypoints
@@ -129,6 +131,7 @@ struct Settings {
   std::optional<bool> register_gaps;                // Tracking.RegisterGaps
   std::optional<bool> register_lost;                // Tracking.RegisterLost
   std::optional<bool> register_refused_steps;       // Tracking.RegisterRefusedSteps
+  std::optional<double> start_doubt_s;              // Tracking.StartDoubt
   std::optional<int> ransac_points_near_prior;      // Tracking.RansacPointsNearPrior
   std::optional<int> ransac_points_near_prior_retry;  // Tracking.RansacPointsNearPriorRetry
   std::optional<bool> depth_consistency;            // LocalMapping.DepthConsistency

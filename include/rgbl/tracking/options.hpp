@@ -165,6 +165,16 @@ struct TrackerOptions {
   double max_acceleration = 10.0;          // m/s^2, 1 g: more than a car brakes
   double step_tolerance_rotation_deg = 3.0;
   int min_jump_inliers = 50;
+  // A velocity that stands on a start without one (a map's second frame, the frame after a loss or a
+  // relocalisation) is in doubt for start_doubt_s seconds. Within them a contested step (refused for
+  // the prediction although clearly more local-map inliers agree with it) is taken when the last
+  // frame's keypoints without depth fit it and not the prediction clearly more often than the other
+  // way round (matched by descriptor; a match fits a motion when it lies on the image of its ray from
+  // 2 m + 1.5 |t| ahead to infinity; a sign test at three sigmas). The scene beyond the LiDAR's reach
+  // cannot move with the vehicles that hold a start's depth; where it does (a truck's top above the
+  // LiDAR's field of view, next to a car braking at the lights) the velocity has a history and is
+  // not in doubt. 0 = off. (docs/accuracy.md, "A start in doubt for its first second")
+  double start_doubt_s = 1.0;
   // Where the images leave two starts of a frame standing further apart than a step's tolerance, the
   // LiDAR decides first when it can: the frame's returns off the road that land on the last frame's
   // scan under one start only vote for it, and a start wins when the votes differ beyond chance over

@@ -270,6 +270,8 @@ class Tracker {
   double velocity_dt_ = 0.0;  // timestamp difference of that pair (0 = unknown)
   bool velocity_steady_ = false;  // velocity_ comes from two consecutive tracked frames (no relocalisation)
   TravelDirection travel_;  // the direction prior's direction
+  // the last frame placed without a steady velocity: its velocity is in doubt (start_doubt_s) since
+  std::optional<double> start_time_;
 };
 
 }  // namespace rgbl
