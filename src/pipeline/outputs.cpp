@@ -174,6 +174,11 @@ std::string summary_json(const RunResult& run) {
   j["registered_rejected_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_registered; });
   // steps refused although clearly more inliers agreed with them than with the pose kept (weak frames)
   j["contested_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_contested; });
+  // [frame, the first frame placed on the start it refuted]
+  j["refuted_starts"] = Json::array();
+  for (const auto& f : run.frames) {
+    if (f.result.start_refuted_since) j["refuted_starts"].push_back({f.result.frame_index, *f.result.start_refuted_since});
+  }
   // first frames after a gap in the timestamps whose scan was registered across it, and those where
   // the registration was accepted as the prediction
   j["gap_frames"] = run.frames_where([](const TrackResult& r) { return r.gap; });
@@ -243,6 +248,12 @@ std::string summary_text(const RunResult& run) {
   if (!contested.empty()) {
     fmt::format_to(out, "  frame(s) placed against clearly more support for another pose (weak): {}\n",
                    fmt::join(contested, ", "));
+  }
+  for (const auto& f : run.frames) {
+    if (const TrackResult& r = f.result; r.start_refuted_since) {
+      fmt::format_to(out, "  start refuted at frame {} (the keypoints without depth fit its contested step): frames {}-{} "
+                     "stay where the wrong start put them\n", r.frame_index, *r.start_refuted_since, r.frame_index - 1);
+    }
   }
   const auto placed = run.frames_where([](const TrackResult& r) { return r.lost_registered; });
   if (!placed.empty()) {

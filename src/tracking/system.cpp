@@ -387,6 +387,7 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   result.step_rejected = outcome.step_rejected;
   result.step_registered = outcome.step_registered;
   result.step_contested = outcome.step_contested;
+  result.start_refuted_since = outcome.start_refuted_since;
   result.gap = outcome.gap;
   result.gap_registered = outcome.gap_registered;
   result.lost_registered = outcome.lost_registered;

@@ -577,6 +577,7 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
                   take ? "the step is taken (the start was wrong)" : "kept at the prediction");
     if (take) {
       h.jump = true;  // reported as a step beyond a vehicle's reach, and weak (contested)
+      h.start_refuted = true;
       h.reference = step_reference;
       return h;
     }
@@ -653,6 +654,7 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
   outcome.step_rejected = h.step_rejected;
   outcome.step_registered = h.step_registered;
   outcome.step_contested = h.ok && h.step_contested;
+  if (h.ok && h.start_refuted) outcome.start_refuted_since = start_frame_;
   outcome.gap = prediction.gap;
   outcome.gap_registered = prediction.registered;
   int inliers = h.inliers;
@@ -669,7 +671,10 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
       velocity_dt_ = frame.timestamp - last_frame_->timestamp;
     }
     // a velocity set without a steady one before it stands on this frame's start alone
-    if (!velocity_steady_ && !h.step_rejected) start_time_ = frame.timestamp;
+    if (!velocity_steady_ && !h.step_rejected) {
+      start_time_ = frame.timestamp;
+      start_frame_ = frame.index;
+    }
     if (last_frame_ && !h.step_rejected) {
       // A velocity from two consecutive tracked frames is steady however the second was placed: one
       // placed against the reference keyframe (the frame after a map's first, which has no velocity)

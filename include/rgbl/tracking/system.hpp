@@ -70,6 +70,9 @@ struct TrackResult {
   // a step beyond a vehicle's reach refused although clearly more inliers (two sigmas) agree with it
   // than with the pose kept, or a start chosen (by the road or the scans) against clearly more: weak
   bool step_contested = false;
+  // a contested step taken within TrackerOptions::start_doubt_s of a start without velocity: the start
+  // was wrong, and the frames from this one (its index) up to this frame were placed on it
+  std::optional<std::size_t> start_refuted_since;
   // the first frame after a gap in the timestamps, its scan registered onto the last frame's
   // (TrackerOptions::register_gaps); gap_registered: the registration was accepted as the prediction
   bool gap = false;

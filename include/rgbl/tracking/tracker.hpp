@@ -42,6 +42,9 @@ struct TrackerOutcome {
   // against the reference keyframe chosen (by the road or the scans) over another start beyond a
   // step's tolerance with clearly more local-map inliers.
   bool step_contested = false;
+  // A contested step taken within start_doubt_s of a start without velocity: the start was wrong, and
+  // the frames since this index were placed on it (they stay where they are).
+  std::optional<std::size_t> start_refuted_since;
   // The first frame after a gap in the frames (TrackerOptions::register_gaps): its scan was registered
   // onto the last frame's; gap_registered: accepted, the registration was the prediction.
   bool gap = false;
@@ -106,6 +109,7 @@ class Tracker {
     // a step beyond reach refused for the prediction's pose though clearly more inliers agree with it,
     // or a start chosen against clearly more: weak, but no keyframe for it (its pose is the one in doubt)
     bool step_contested = false;
+    bool start_refuted = false;  // ...taken, within start_doubt_s of a start (start_frame_)
     int inliers = 0;
     KeyframeId reference;                   // the reference keyframe it leaves
     std::size_t relocalisation_frame = 0;   // the last relocalisation, this frame's if it made one
@@ -272,6 +276,7 @@ class Tracker {
   TravelDirection travel_;  // the direction prior's direction
   // the last frame placed without a steady velocity: its velocity is in doubt (start_doubt_s) since
   std::optional<double> start_time_;
+  std::size_t start_frame_ = 0;  // its index
 };
 
 }  // namespace rgbl
