@@ -562,7 +562,7 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   // keypoints without depth, the scene beyond the LiDAR's reach that vehicles around the car rarely
   // hold, decide a contested step there. Traffic seed 13 starts standing among trucks at its speed and
   // at frame 5 (0.4 s) 57 of them fit the true 1.0 m step alone, 5 the prediction; seed 22, started
-  // right, has its steps contested by the trucks at frames 4-7 and 2-3 fit those alone, 7-20 the prediction.
+  // right, has its steps contested by the trucks at frames 4-7 and 1-3 fit those alone, 7-20 the prediction.
   if (h.step_contested && start_time_ && h.frame.timestamp - *start_time_ <= options_.start_doubt_s) {
     const Eigen::Isometry3d T_world_last = last_frame_->T_cam_world.inverse();
     const RayFits fits = fits_by_rays(camera_, *last_frame_, h.frame, h.frame.T_cam_world * T_world_last,
