@@ -441,7 +441,7 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
 }
 
 RayFits fits_by_rays(const PinholeCamera& camera, const Frame& last, const Frame& frame, const Eigen::Isometry3d& T_a,
-                     const Eigen::Isometry3d& T_b, int max_hamming) {
+                     const Eigen::Isometry3d& T_b, int max_hamming, double scale_factor) {
   std::vector<std::size_t> rows;  // last's keypoints without depth
   std::vector<Descriptor> query;
   for (std::size_t i = 0; i < last.size(); ++i) {
@@ -459,7 +459,7 @@ RayFits fits_by_rays(const PinholeCamera& camera, const Frame& last, const Frame
     const Eigen::Vector2d ab = b - a;
     const double length2 = ab.squaredNorm();
     const double s = length2 > 0.0 ? std::clamp((px - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-    return (a + s * ab - px).norm() <= 2.0 * std::pow(1.2, k.level);
+    return (a + s * ab - px).norm() <= 2.0 * std::pow(scale_factor, k.level);
   };
   RayFits result;
   for (const auto& [q, t] : detail::match_brute_force(query, frame.descriptors, max_hamming, 0.8)) {

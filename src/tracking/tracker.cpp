@@ -566,7 +566,8 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   if (h.step_contested && start_time_ && h.frame.timestamp - *start_time_ <= options_.start_doubt_s) {
     const Eigen::Isometry3d T_world_last = last_frame_->T_cam_world.inverse();
     const RayFits fits = fits_by_rays(camera_, *last_frame_, h.frame, h.frame.T_cam_world * T_world_last,
-                                      prediction.T_cam_world * T_world_last, options_.motion_max_hamming);
+                                      prediction.T_cam_world * T_world_last, options_.motion_max_hamming,
+                                      map_.options().scale_factor);
     const int step_only = fits.a_only;
     const int kept_only = fits.b_only;
     const bool take = step_only - kept_only > 3.0 * std::sqrt(static_cast<double>(step_only + kept_only));

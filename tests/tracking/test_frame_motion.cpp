@@ -385,18 +385,18 @@ TEST_CASE("rays without depth: the scene beyond the LiDAR tells a driving camera
   std::fill(last.depth.begin(), last.depth.end(), 0.0F);
   std::fill(last.depth_sigma.begin(), last.depth_sigma.end(), 0.0F);
 
-  const rgbl::RayFits drive_or_stand = rgbl::fits_by_rays(cam, last, cur, T_drive, T_stand, 100);
+  const rgbl::RayFits drive_or_stand = rgbl::fits_by_rays(cam, last, cur, T_drive, T_stand, 100, 1.2);
   CHECK(drive_or_stand.matches == 240);
   CHECK(drive_or_stand.a_only >= 140);  // the facades' parallax; the truck and the far points fit both
   CHECK(drive_or_stand.b_only == 0);
-  const rgbl::RayFits stand_or_drive = rgbl::fits_by_rays(cam, last, cur, T_stand, T_drive, 100);
+  const rgbl::RayFits stand_or_drive = rgbl::fits_by_rays(cam, last, cur, T_stand, T_drive, 100, 1.2);
   CHECK(stand_or_drive.a_only == drive_or_stand.b_only);
   CHECK(stand_or_drive.b_only == drive_or_stand.a_only);
   // sideways is no forward step either: the facades fit the true motion alone
-  const rgbl::RayFits drive_or_side = rgbl::fits_by_rays(cam, last, cur, T_drive, T_side, 100);
+  const rgbl::RayFits drive_or_side = rgbl::fits_by_rays(cam, last, cur, T_drive, T_side, 100, 1.2);
   CHECK(drive_or_side.a_only >= 120);
   CHECK(drive_or_side.b_only <= 5);
   // keypoints with depth are not asked: the LiDAR decides those
   std::fill(last.depth.begin(), last.depth.end(), 12.0F);
-  CHECK(rgbl::fits_by_rays(cam, last, cur, T_drive, T_stand, 100).matches == 0);
+  CHECK(rgbl::fits_by_rays(cam, last, cur, T_drive, T_stand, 100, 1.2).matches == 0);
 }

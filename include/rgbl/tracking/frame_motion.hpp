@@ -17,7 +17,7 @@ namespace rgbl {
 
 // Two motions T_cur_last judged on what depth cannot hold: `last`'s keypoints without depth, matched to
 // `frame` by descriptor (nearest neighbour, ratio 0.8, Hamming <= max_hamming). A match fits a motion
-// when its keypoint in `frame` lies within 2 px x 1.2^level of the image of its ray in `last`, from
+// when its keypoint in `frame` lies within 2 px x scale_factor^level (the pyramid's) of the image of its ray in `last`, from
 // 2 m + 1.5 |t| ahead (nearer, the LiDAR would have given it depth) to infinity. Far points fit every
 // translation; a car standing still and one driving differ on the points in between (facades, trees
 // above the LiDAR's field of view). Each motion's count is of the matches that fit it alone.
@@ -27,7 +27,7 @@ struct RayFits {
   int b_only = 0;
 };
 RayFits fits_by_rays(const PinholeCamera& camera, const Frame& last, const Frame& frame, const Eigen::Isometry3d& T_a,
-                     const Eigen::Isometry3d& T_b, int max_hamming);
+                     const Eigen::Isometry3d& T_b, int max_hamming, double scale_factor);
 
 // T_cur_last (maps points of `last`'s camera into `frame`'s) from brute-force matches (ratio test)
 // between keypoints with usable depth and a 3-point RANSAC on their 3-D alignment (Umeyama), refined
