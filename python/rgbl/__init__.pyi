@@ -331,7 +331,7 @@ class TrackResult:
     jump: bool
     step_rejected: bool
     step_registered: bool  # a rejected step's frame placed by its scan's registration onto the last frame's
-    step_contested: bool  # a step refused, or a start chosen, against clearly more inliers for another pose (weak)
+    step_contested: bool  # a step refused although clearly more inliers agreed with it than with the pose kept (weak)
     start_refuted_since: Optional[int]  # a start given up here: the first frame placed on it (Tracking.StartDoubt)
     gap: bool  # the first frame after a gap in the timestamps, its scan registered onto the last one's
     gap_registered: bool  # ...and the registration was accepted as the prediction

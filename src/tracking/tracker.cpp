@@ -283,17 +283,12 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
       for (std::size_t i = 0; i < ground.size(); ++i) count += ground[i] && f.landmarks[i].valid() ? 1 : 0;
       return count;
     };
-    // every start the local map judged (its pose and inliers): a start chosen against clearly more
-    // inliers elsewhere is contested (below)
-    std::vector<std::pair<Eigen::Isometry3d, int>> judged;
-    if (!others.empty()) judged.emplace_back(frame.T_cam_world, first.local.inliers);
     for (OtherStart& other_start : others) {
       // starts converged to different poses: the local map decides. A rival motion's views count
       // only if it wins, so that a start that loses leaves the map's statistics as they were.
       ViewLog rival_views;
       ViewLog& other_views = other_start.rival ? rival_views : views;
       const LocalMapResult other = track_local_map(other_start.frame, reference, h.relocalisation_frame, other_views);
-      judged.emplace_back(other_start.frame.T_cam_world, other.inliers);
       const int road = on_road(frame), other_road = on_road(other_start.frame);
       logger()->debug("frame {}: against the reference keyframe, the local map finds {} of {} points ({} on the road) "
                       "from the first start, {} of {} ({} on the road) from the {} ({:.2f} m apart)", frame.index,
@@ -326,22 +321,6 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
         views.visible.insert(views.visible.end(), rival_views.visible.begin(), rival_views.visible.end());
         views.found.insert(views.found.end(), rival_views.found.begin(), rival_views.found.end());
       }
-    }
-    // The road and the scans outrank the local map's inliers among starts, as vehicles hold many of
-    // those. Where a start apart from the one chosen (beyond a step's tolerance) has clearly more,
-    // by two sigmas of the counts' difference as for a contested step, the evidence contradicts the
-    // start: the frame is weak, with no keyframe of its own (traffic seed 23, frame 1: the road picks
-    // a start 2.8 m sideways on lane lines 3.3 m apart, 38 inliers against 165 at the true 1.0 m).
-    for (const auto& [T_cam_world, inliers] : judged) {
-      const double margin = 2.0 * std::sqrt(static_cast<double>(inliers + first.local.inliers));
-      if (inliers - first.local.inliers > margin &&
-          !check_step(frame.T_cam_world, T_cam_world, 0.0, dt, options_).plausible) {
-        h.step_contested = true;
-      }
-    }
-    if (h.step_contested) {
-      logger()->debug("frame {}: start chosen on {} local-map inliers against another start with clearly more: weak",
-                      frame.index, first.local.inliers);
     }
     ok = first.local.ok;
     if (ok && h.relocalised && !relocalisation_confirmed(first.local)) {

@@ -21,9 +21,6 @@
 #   (Tracking.StartDoubt: 0). By default the start is in doubt for its first second: at frame 5 the
 #   keypoints without depth fit the contested step alone 57 times, the prediction 5, and the step is
 #   taken (weak, ATE 0.64 m: frames 1-4 stay where the wrong start put them).
-# - Seed 23, defaults: at frame 1 the road picks a start 2.8 m sideways (lane lines repeat across the
-#   lanes: 18 of its 38 inliers on the road) over the true 1.0 m (165, 5 on the road); the run ends
-#   0.33 m off. The start is contested: frame 1 is weak, and the summary names it.
 set(FRAMES 80)
 set(MAX_WEAK ${FRAMES})  # weak frames allowed, as long as none is lost
 if(NOT DEFINED SEED)

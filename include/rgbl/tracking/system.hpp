@@ -68,7 +68,7 @@ struct TrackResult {
   bool step_rejected = false;  // a step beyond a vehicle's reach on weak evidence: weak, at the prediction
   bool step_registered = false;  // ...placed by its scan's registration onto the last frame's instead
   // a step beyond a vehicle's reach refused although clearly more inliers (two sigmas) agree with it
-  // than with the pose kept, or a start chosen (by the road or the scans) against clearly more: weak
+  // than with the pose kept: weak
   bool step_contested = false;
   // a contested step taken within TrackerOptions::start_doubt_s of a start without velocity: the start
   // was wrong, and the frames from this one (its index) up to this frame were placed on it

@@ -38,9 +38,7 @@ struct TrackerOutcome {
   bool step_rejected = false;  // ...on weak evidence: the frame is weak, placed at the prediction
   bool step_registered = false;  // ...or by its scan (TrackerOptions::register_refused_steps)
   // ...or the step was refused although clearly more local-map inliers (two sigmas) agree with it than
-  // with the pose kept: the frame is weak (the evidence contradicts its pose). Also set for a start
-  // against the reference keyframe chosen (by the road or the scans) over another start beyond a
-  // step's tolerance with clearly more local-map inliers.
+  // with the pose kept: the frame is weak (the evidence contradicts its pose)
   bool step_contested = false;
   // A contested step taken within start_doubt_s of a start without velocity: the start was wrong, and
   // the frames since this index were placed on it (they stay where they are).
@@ -106,8 +104,8 @@ class Tracker {
     bool jump = false;           // a step beyond a vehicle's reach, taken on strong evidence
     bool step_rejected = false;  // ...on weak evidence: placed at the prediction
     bool step_registered = false;  // ...or by its scan (TrackerOptions::register_refused_steps)
-    // a step beyond reach refused for the prediction's pose though clearly more inliers agree with it,
-    // or a start chosen against clearly more: weak, but no keyframe for it (its pose is the one in doubt)
+    // a step beyond reach refused for the prediction's pose though clearly more inliers agree with it:
+    // weak, but no keyframe for it (the frame adds nothing the map lacks, its pose is the one in doubt)
     bool step_contested = false;
     bool start_refuted = false;  // ...taken, within start_doubt_s of a start (start_frame_)
     int inliers = 0;
