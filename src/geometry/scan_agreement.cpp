@@ -183,12 +183,14 @@ int ScanVote::object_preference() const {
   return 0;
 }
 
-int ScanVote::preference() const {
-  const double difference = static_cast<double>(only_b) - static_cast<double>(only_a);
-  const double spread = 3.0 * std::sqrt(static_cast<double>(only_a + only_b));
+int count_preference(std::size_t a, std::size_t b, double sigmas) {
+  const double difference = static_cast<double>(b) - static_cast<double>(a);
+  const double spread = sigmas * std::sqrt(static_cast<double>(a + b));
   if (difference > spread) return 1;
   if (-difference > spread) return -1;
   return 0;
 }
+
+int ScanVote::preference() const { return count_preference(only_a, only_b, 3.0); }
 
 }  // namespace rgbl

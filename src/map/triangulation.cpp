@@ -2,6 +2,7 @@
 
 #include "rgbl/core/error.hpp"
 #include "rgbl/features/matcher.hpp"
+#include "rgbl/geometry/epipolar.hpp"
 #include "rgbl/geometry/se3.hpp"
 
 #include <algorithm>
@@ -68,28 +69,6 @@ std::vector<bool> open_keypoints(const Keyframe& kf, const PinholeCamera& camera
   return open;
 }
 
-// Clips the segment a-b to the rectangle [lo, hi] (Liang-Barsky); false when nothing is left.
-bool clip_segment(Eigen::Vector2d& a, Eigen::Vector2d& b, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
-  double t0 = 0.0, t1 = 1.0;
-  const Eigen::Vector2d d = b - a;
-  for (int axis = 0; axis < 2; ++axis) {
-    for (const auto& [p, q] : {std::pair{-d(axis), a(axis) - lo(axis)}, std::pair{d(axis), hi(axis) - a(axis)}}) {
-      if (p == 0.0) {
-        if (q < 0.0) return false;
-        continue;
-      }
-      const double r = q / p;
-      if (p < 0.0) t0 = std::max(t0, r);
-      else t1 = std::min(t1, r);
-    }
-  }
-  if (t0 > t1) return false;
-  const Eigen::Vector2d start = a + t0 * d;
-  b = a + t1 * d;
-  a = start;
-  return true;
-}
-
 // The open keypoints of a keyframe bucketed in square cells.
 class OpenCells {
  public:
@@ -147,26 +126,6 @@ class OpenCells {
   std::vector<int> offsets_;
   std::vector<std::size_t> indices_;
 };
-
-// Where the keypoint's ray (z = 1 in its own camera) can appear in the other camera: the projections
-// of its points from depth min_depth to infinity that lie in front of the other camera, as a segment
-// clipped to the image widened by `margin`.
-std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> epipolar_segment(const Eigen::Isometry3d& T_other_own,
-                                                                           const Eigen::Vector3d& ray, double min_depth,
-                                                                           const PinholeCamera& camera, double margin) {
-  // the point at inverse depth rho, up to scale: R ray + t rho; in front where its z > 0
-  const Eigen::Vector3d far = T_other_own.linear() * ray, t = T_other_own.translation();
-  constexpr double kFront = 1e-3;
-  double rho_lo = 0.0, rho_hi = 1.0 / min_depth;
-  const auto z = [&](double rho) { return far.z() + t.z() * rho; };
-  if (z(rho_lo) <= kFront && z(rho_hi) <= kFront) return std::nullopt;
-  if (z(rho_lo) <= kFront) rho_lo = (kFront - far.z()) / t.z();
-  if (z(rho_hi) <= kFront) rho_hi = (kFront - far.z()) / t.z();
-  Eigen::Vector2d a = camera.project_unchecked(far + t * rho_lo), b = camera.project_unchecked(far + t * rho_hi);
-  if (!clip_segment(a, b, Eigen::Vector2d(-margin, -margin), Eigen::Vector2d(camera.width + margin, camera.height + margin)))
-    return std::nullopt;
-  return std::pair{a, b};
-}
 
 struct Proposal {
   std::size_t own = 0, other = 0;

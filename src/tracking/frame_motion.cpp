@@ -2,6 +2,7 @@
 
 #include "matching.hpp"
 #include "rgbl/core/log.hpp"
+#include "rgbl/geometry/epipolar.hpp"
 #include "rgbl/geometry/voxel_index.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -450,16 +451,11 @@ RayFits fits_by_rays(const PinholeCamera& camera, const Frame& last, const Frame
     query.push_back(last.descriptors[i]);
   }
   const auto fits = [&](const Eigen::Isometry3d& T, const Eigen::Vector3d& ray, const Keypoint& k) {
-    const Eigen::Vector3d p_near = T * (ray * (2.0 + 1.5 * T.translation().norm()));
-    const Eigen::Vector3d at_infinity = T.linear() * ray;  // a direction: its image is the far end
-    if (p_near.z() <= 1e-3 || at_infinity.z() <= 1e-3) return false;
-    const Eigen::Vector2d a = camera.project_unchecked(p_near);
-    const Eigen::Vector2d b = camera.project_unchecked(at_infinity);
-    const Eigen::Vector2d px(k.x, k.y);
-    const Eigen::Vector2d ab = b - a;
-    const double length2 = ab.squaredNorm();
-    const double s = length2 > 0.0 ? std::clamp((px - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-    return (a + s * ab - px).norm() <= 2.0 * std::pow(scale_factor, k.level);
+    // clipped to the image widened by the radius: a keypoint in the image within the radius of the
+    // whole segment is within it of the clipped one
+    const double radius = 2.0 * std::pow(scale_factor, k.level);
+    const auto segment = epipolar_segment(T, ray, 2.0 + 1.5 * T.translation().norm(), camera, radius);
+    return segment && distance_to_segment(Eigen::Vector2d(k.x, k.y), segment->first, segment->second) <= radius;
   };
   RayFits result;
   for (const auto& [q, t] : detail::match_brute_force(query, frame.descriptors, max_hamming, 0.8)) {
@@ -474,6 +470,5 @@ RayFits fits_by_rays(const PinholeCamera& camera, const Frame& last, const Frame
   }
   return result;
 }
-
 
 }  // namespace rgbl

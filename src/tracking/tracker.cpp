@@ -531,8 +531,8 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   // inliers on the true 1.0 m steps against 196-221 at the prediction, standing still). Clearly: by
   // two sigmas of the counts' difference, each count taken as Poisson (sigma sqrt(a + b)); a few
   // inliers either way are a tie (traffic seed 3 at the lights: 252 against 246).
-  const double margin = 2.0 * std::sqrt(static_cast<double>(h.inliers + from_prediction.inliers));
-  h.step_contested = plausible_alternative && h.inliers - from_prediction.inliers > margin;
+  h.step_contested = plausible_alternative && count_preference(static_cast<std::size_t>(from_prediction.inliers),
+                                                               static_cast<std::size_t>(h.inliers), 2.0) > 0;
   if (h.step_contested) {
     logger()->debug("frame {}: kept at the prediction on {} inliers against a step with {}: weak", h.frame.index,
                     from_prediction.inliers, h.inliers);
@@ -542,18 +542,17 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   // hold, decide a contested step there. Traffic seed 13 starts standing among trucks at its speed and
   // at frame 5 (0.4 s) 57 of them fit the true 1.0 m step alone, 5 the prediction; seed 22, started
   // right, has its steps contested by the trucks at frames 4-7 and 1-3 fit those alone, 7-20 the prediction.
-  if (h.step_contested && start_time_ && h.frame.timestamp - *start_time_ <= options_.start_doubt_s) {
+  if (h.step_contested && start_ && h.frame.timestamp - start_->time <= options_.start_doubt_s) {
     const Eigen::Isometry3d T_world_last = last_frame_->T_cam_world.inverse();
+    // a: the step, b: the prediction
     const RayFits fits = fits_by_rays(camera_, *last_frame_, h.frame, h.frame.T_cam_world * T_world_last,
                                       prediction.T_cam_world * T_world_last, options_.motion_max_hamming,
                                       map_.options().scale_factor);
-    const int step_only = fits.a_only;
-    const int kept_only = fits.b_only;
-    const bool take = step_only - kept_only > 3.0 * std::sqrt(static_cast<double>(step_only + kept_only));
+    const bool take = count_preference(fits.a_only, fits.b_only, 3.0) < 0;
     logger()->log(take ? spdlog::level::warn : spdlog::level::debug,
                   "frame {}: {:.2f} s after a start without velocity, the keypoints without depth fit the contested "
                   "step alone {} times, the prediction alone {}: {}", h.frame.index,
-                  h.frame.timestamp - *start_time_, step_only, kept_only,
+                  h.frame.timestamp - start_->time, fits.a_only, fits.b_only,
                   take ? "the step is taken (the start was wrong)" : "kept at the prediction");
     if (take) {
       h.jump = true;  // reported as a step beyond a vehicle's reach, and weak (contested)
@@ -633,8 +632,8 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
   outcome.jump = h.jump;
   outcome.step_rejected = h.step_rejected;
   outcome.step_registered = h.step_registered;
-  outcome.step_contested = h.ok && h.step_contested;
-  if (h.ok && h.start_refuted) outcome.start_refuted_since = start_frame_;
+  outcome.step_contested = h.step_contested;
+  if (h.start_refuted) outcome.start_refuted_since = start_->frame;
   outcome.gap = prediction.gap;
   outcome.gap_registered = prediction.registered;
   int inliers = h.inliers;
@@ -651,10 +650,7 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
       velocity_dt_ = frame.timestamp - last_frame_->timestamp;
     }
     // a velocity set without a steady one before it stands on this frame's start alone
-    if (!velocity_steady_ && !h.step_rejected) {
-      start_time_ = frame.timestamp;
-      start_frame_ = frame.index;
-    }
+    if (!velocity_steady_ && !h.step_rejected) start_ = Start{frame.timestamp, frame.index};
     if (last_frame_ && !h.step_rejected) {
       // A velocity from two consecutive tracked frames is steady however the second was placed: one
       // placed against the reference keyframe (the frame after a map's first, which has no velocity)

@@ -368,20 +368,23 @@ TEST_CASE("frame motion: near a prior with every keypoint with depth, a scene in
 TEST_CASE("rays without depth: the scene beyond the LiDAR tells a driving camera from one standing among vehicles") {
   const rgbl::PinholeCamera cam = rgbl::test::kitti_camera();
   std::mt19937 rng(5);
-  // The car drives 1.0 m forward. Without depth: 150 facade points 10-40 m ahead on both sides, 60
+  // The car drives 1.0 m forward. Without depth: 150 facade points 11-16 m ahead on both sides, 60
   // points on a truck's top alongside that moves with the car (they stay put in the image), 30 points
-  // near infinity (they fit any translation).
+  // near infinity (they fit any translation). All in view in both frames, as keypoints are.
   Eigen::Isometry3d T_drive = Eigen::Isometry3d::Identity();
   T_drive.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);
   Eigen::Isometry3d T_side = Eigen::Isometry3d::Identity();
   T_side.translation() = Eigen::Vector3d(1.0, 0.0, 0.0);
   const Eigen::Isometry3d T_stand = Eigen::Isometry3d::Identity();
   Scene s;
-  add_points(s, rng, 75, {-14.0, -6.0, 10.0}, {-7.0, -1.0, 40.0}, T_drive);
-  add_points(s, rng, 75, {7.0, -6.0, 10.0}, {14.0, -1.0, 40.0}, T_drive);
-  add_points(s, rng, 60, {2.5, -3.5, 6.0}, {4.0, -2.5, 14.0}, T_stand);
+  add_points(s, rng, 75, {-8.0, -2.2, 11.0}, {-6.0, -1.2, 16.0}, T_drive);
+  add_points(s, rng, 75, {6.0, -2.2, 11.0}, {8.0, -1.2, 16.0}, T_drive);
+  add_points(s, rng, 60, {2.5, -1.5, 6.0}, {4.0, -0.8, 14.0}, T_stand);
   add_points(s, rng, 30, {-400.0, -200.0, 3000.0}, {400.0, -50.0, 4000.0}, T_drive);
   auto [last, cur] = frames_of(s, cam, rng);
+  for (const rgbl::Frame* f : {&last, &cur}) {
+    for (const rgbl::Keypoint& k : f->keypoints) REQUIRE((k.x >= 0.0F && k.x < cam.width && k.y >= 0.0F && k.y < cam.height));
+  }
   std::fill(last.depth.begin(), last.depth.end(), 0.0F);
   std::fill(last.depth_sigma.begin(), last.depth_sigma.end(), 0.0F);
 

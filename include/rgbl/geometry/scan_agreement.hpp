@@ -54,6 +54,10 @@ std::vector<std::uint32_t> label_objects(const ScanSample& sample, double edge);
 // without a nonzero difference.
 double signed_rank_z(std::span<const double> differences);
 
+// Two counts compared beyond chance: +1 for b, -1 for a, 0 when |b - a| <= sigmas sqrt(a + b) (each
+// count Poisson, or McNemar's test on the discordant pairs of paired counts).
+int count_preference(std::size_t a, std::size_t b, double sigmas);
+
 // How the points of one sample vote between two poses of it against a reference: the points that
 // land on the reference under one pose and not under the other.
 struct ScanVote {

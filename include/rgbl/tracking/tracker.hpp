@@ -107,7 +107,7 @@ class Tracker {
     // a step beyond reach refused for the prediction's pose though clearly more inliers agree with it:
     // weak, but no keyframe for it (the frame adds nothing the map lacks, its pose is the one in doubt)
     bool step_contested = false;
-    bool start_refuted = false;  // ...taken, within start_doubt_s of a start (start_frame_)
+    bool start_refuted = false;  // ...taken, within start_doubt_s of a start (start_)
     int inliers = 0;
     KeyframeId reference;                   // the reference keyframe it leaves
     std::size_t relocalisation_frame = 0;   // the last relocalisation, this frame's if it made one
@@ -272,9 +272,12 @@ class Tracker {
   double velocity_dt_ = 0.0;  // timestamp difference of that pair (0 = unknown)
   bool velocity_steady_ = false;  // velocity_ comes from two consecutive tracked frames (no relocalisation)
   TravelDirection travel_;  // the direction prior's direction
-  // the last frame placed without a steady velocity: its velocity is in doubt (start_doubt_s) since
-  std::optional<double> start_time_;
-  std::size_t start_frame_ = 0;  // its index
+  // the last frame placed without a steady velocity: the velocity is in doubt (start_doubt_s) since
+  struct Start {
+    double time = 0.0;
+    std::size_t frame = 0;
+  };
+  std::optional<Start> start_;
 };
 
 }  // namespace rgbl
