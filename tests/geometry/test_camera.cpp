@@ -76,26 +76,21 @@ TEST_CASE("camera validation names the bad option") {
 }
 
 TEST_CASE("epipolar segment: a ray from its nearest depth to infinity, clipped to the widened image", "[geometry]") {
-  rgbl::PinholeCamera cam;
-  cam.fx = cam.fy = 500.0;
-  cam.cx = 320.0;
-  cam.cy = 240.0;
-  cam.width = 640;
-  cam.height = 480;
+  const rgbl::PinholeCamera cam = kitti_like();
   const Eigen::Vector3d ray(0.2, 0.0, 1.0);  // z = 1: the point at depth d is d * ray
   // driving 1 m forward: the far end stays on the ray's pixel, the nearest point (4 m, now 3 m ahead) moves out
   Eigen::Isometry3d T_forward = Eigen::Isometry3d::Identity();
   T_forward.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);
   const auto s = rgbl::epipolar_segment(T_forward, ray, 4.0, cam, 2.0);
   REQUIRE(s);
-  CHECK(s->first.x() == Approx(420.0));                  // 320 + 500 * 0.2
-  CHECK(s->second.x() == Approx(320.0 + 500.0 * 0.8 / 3.0));  // 4 m * 0.2 sideways, 3 m ahead
-  CHECK(s->first.y() == Approx(240.0));
-  // from a nearest depth of 1.2 m: that point would be 0.2 m ahead at 0.24 m sideways, x = 920,
-  // so the segment is clipped at the image's edge plus the margin
+  CHECK(s->first.x() == Approx(cam.cx + cam.fx * 0.2));
+  CHECK(s->second.x() == Approx(cam.cx + cam.fx * 0.8 / 3.0));  // 4 m * 0.2 sideways, 3 m ahead
+  CHECK(s->first.y() == Approx(cam.cy));
+  // from a nearest depth of 1.2 m: that point would be 0.2 m ahead at 0.24 m sideways (x = cx +
+  // 1.2 fx, beyond the image), so the segment is clipped at the image's edge plus the margin
   const auto clipped = rgbl::epipolar_segment(T_forward, ray, 1.2, cam, 2.0);
   REQUIRE(clipped);
-  CHECK(clipped->second.x() == Approx(642.0));
+  CHECK(clipped->second.x() == Approx(cam.width + 2.0));
   // a ray that ends behind the camera: nothing of it in view
   Eigen::Isometry3d T_turned = Eigen::Isometry3d::Identity();
   T_turned.linear() = Eigen::AngleAxisd(3.14159265358979, Eigen::Vector3d::UnitY()).toRotationMatrix();
