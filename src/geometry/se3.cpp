@@ -85,6 +85,10 @@ Eigen::Isometry3d make_isometry(const Eigen::Matrix3d& R, const Eigen::Vector3d&
   return T;
 }
 
+Eigen::Isometry3d pose_at_centre(const Eigen::Matrix3d& R_cam_world, const Eigen::Vector3d& centre) {
+  return make_isometry(R_cam_world, -(R_cam_world * centre));
+}
+
 Eigen::Isometry3d orthonormalized(const Eigen::Isometry3d& T) {
   return make_isometry(Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix(), T.translation());
 }

@@ -428,6 +428,9 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.start_doubt_s = r.number({"Tracking.StartDoubt"});
   if (s.start_doubt_s && !(*s.start_doubt_s >= 0.0 && *s.start_doubt_s <= 60.0))
     r.fail("Tracking.StartDoubt", "seconds from 0 (off) to 60");
+  s.speed_window_s = r.number({"Tracking.SpeedWindow"});
+  if (s.speed_window_s && !(*s.speed_window_s >= 0.0 && *s.speed_window_s <= 5.0))
+    r.fail("Tracking.SpeedWindow", "seconds from 0 (off) to 5");
   s.ransac_points_near_prior = r.integer({"Tracking.RansacPointsNearPrior"});
   if (s.ransac_points_near_prior && *s.ransac_points_near_prior < 3)
     r.fail("Tracking.RansacPointsNearPrior", "at least 3 keypoints (a rigid motion needs 3 points)");

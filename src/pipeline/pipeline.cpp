@@ -102,6 +102,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.register_lost) p.system.tracker.register_lost = *s.register_lost;
   if (s.register_refused_steps) p.system.tracker.register_refused_steps = *s.register_refused_steps;
   if (s.start_doubt_s) p.system.tracker.start_doubt_s = *s.start_doubt_s;
+  if (s.speed_window_s) p.system.tracker.speed_window_s = *s.speed_window_s;
   if (s.ransac_points_near_prior) {
     p.system.tracker.ransac_max_points_near_prior = static_cast<std::size_t>(*s.ransac_points_near_prior);
   }

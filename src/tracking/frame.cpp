@@ -82,6 +82,7 @@ void TrackerOptions::validate() const {
           "tracker.step_tolerance_rotation_deg", "in [0, 180] degrees");
   require(min_jump_inliers >= min_pose_inliers, "tracker.min_jump_inliers", ">= tracker.min_pose_inliers");
   require(start_doubt_s >= 0.0 && std::isfinite(start_doubt_s), "tracker.start_doubt_s", ">= 0 s (0 = off)");
+  require(speed_window_s >= 0.0 && std::isfinite(speed_window_s), "tracker.speed_window_s", ">= 0 s (0 = off)");
   require(max_frames_between_keyframes >= 1, "tracker.max_frames_between_keyframes", ">= 1");
   require(max_queued_keyframes >= 1, "tracker.max_queued_keyframes", ">= 1");
   require(reference_ratio_threshold > 0.0 && reference_ratio_threshold <= 1.0, "tracker.reference_ratio_threshold",

@@ -88,6 +88,35 @@ StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry
   return check;
 }
 
+std::optional<SpeedCheck> check_speed(std::span<const PlacedCentre> recent, double time, const Eigen::Vector3d& centre,
+                                      const TrackerOptions& options) {
+  const double window = options.speed_window_s;
+  if (!(window > 0.0) || recent.size() < 3) return std::nullopt;
+  const double reach = 0.9 * window;
+  // the latest entry at least `reach` before t, searched from the newest back
+  const auto latest_before = [&](std::size_t end, double t) -> std::optional<std::size_t> {
+    for (std::size_t i = end; i-- > 0;) {
+      if (t - recent[i].time >= reach) return i;
+    }
+    return std::nullopt;
+  };
+  const auto anchor = latest_before(recent.size(), time);
+  if (!anchor || *anchor + 1 >= recent.size()) return std::nullopt;
+  const auto start = latest_before(*anchor, recent[*anchor].time);
+  if (!start) return std::nullopt;
+  const PlacedCentre& a = recent[*anchor];
+  const PlacedCentre& b = recent[*start];
+  SpeedCheck check;
+  check.velocity = (a.centre - b.centre) / (a.time - b.time);
+  check.span_s = time - a.time;
+  check.frames_back = recent.size() - *anchor;
+  check.expected_centre = a.centre + check.velocity * check.span_s;
+  check.deviation_m = (centre - check.expected_centre).norm();
+  check.allowed_m = allowed_step(check.velocity.norm() * check.span_s, check.span_s, options);
+  check.plausible = check.deviation_m <= check.allowed_m;
+  return check;
+}
+
 void TravelDirection::add(const Eigen::Isometry3d& T_last_world, const Eigen::Isometry3d& T_cur_world,
                           const TrackerOptions& options) {
   const Eigen::Vector3d step = step_in_mid_frame(T_last_world, T_cur_world);

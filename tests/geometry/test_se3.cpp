@@ -74,3 +74,13 @@ TEST_CASE("3x4 conversions round trip") {
   const Eigen::Isometry3d T = rgbl::se3_exp(random_twist(rng, 2.0));
   CHECK((rgbl::isometry_from_3x4(rgbl::to_3x4(T)).matrix() - T.matrix()).norm() < 1e-15);
 }
+
+TEST_CASE("a pose placed by its camera centre keeps the rotation and has that centre") {
+  std::mt19937 rng(5);
+  const Eigen::Isometry3d T = rgbl::se3_exp(random_twist(rng, 2.0));
+  const Eigen::Vector3d centre(1.0, -2.0, 30.0);
+  const Eigen::Isometry3d placed = rgbl::pose_at_centre(T.linear(), centre);
+  CHECK((placed.linear() - T.linear()).norm() == 0.0);
+  CHECK((placed.inverse().translation() - centre).norm() < 1e-12);
+  CHECK((placed * centre).norm() < 1e-12);  // the centre is the camera's origin
+}

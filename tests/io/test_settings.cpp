@@ -266,13 +266,13 @@ TEST_CASE("settings: the LiDAR pair's sigmas and the scan samples' elevation cor
   }
 }
 
-TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, RegisterGaps, CauchyWeights, ObjectTest, DirectionPrior, RegisterRefusedSteps, StartDoubt, RansacPointsNearPrior(Retry), LocalMapping.DepthConsistency and Triangulation, read and validated", "[io][settings]") {
+TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, RegisterGaps, CauchyWeights, ObjectTest, DirectionPrior, RegisterRefusedSteps, StartDoubt, SpeedWindow, RansacPointsNearPrior(Retry), LocalMapping.DepthConsistency and Triangulation, read and validated", "[io][settings]") {
   rgbl::test::TempDir tmp;
   const auto s = rgbl::read_settings(tmp.write(
       "t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0.25\nTracking.BoundedDepthError: 1\nTracking.RegisterGaps: 0\n"
                 "Tracking.CauchyWeights: 0\nTracking.ObjectTest: 1\nTracking.DirectionPrior: 0\n"
                 "Tracking.RegisterRefusedSteps: 0\nTracking.RansacPointsNearPrior: 500\n"
-                "Tracking.RansacPointsNearPriorRetry: 0\nTracking.StartDoubt: 0.5\n"
+                "Tracking.RansacPointsNearPriorRetry: 0\nTracking.StartDoubt: 0.5\nTracking.SpeedWindow: 0.4\n"
                 "LocalMapping.DepthConsistency: 1\nLocalMapping.Triangulation: 1\n"));
   REQUIRE(s.reference_landmark_ratio);
   CHECK(*s.reference_landmark_ratio == 0.25);
@@ -287,6 +287,7 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK(s.ransac_points_near_prior == 500);
   CHECK(s.ransac_points_near_prior_retry == 0);
   CHECK(s.start_doubt_s == 0.5);
+  CHECK(s.speed_window_s == 0.4);
   CHECK(s.warnings.empty());
   const auto unset = rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n"));
   CHECK_FALSE(unset.reference_landmark_ratio);
@@ -301,6 +302,9 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK_FALSE(unset.ransac_points_near_prior);
   CHECK_FALSE(unset.ransac_points_near_prior_retry);
   CHECK_FALSE(unset.start_doubt_s);
+  CHECK_FALSE(unset.speed_window_s);
+  CHECK_THAT(error_of(tmp.write("window.yaml", "%YAML:1.0\nTracking.SpeedWindow: 6\n")),
+             Contains("'Tracking.SpeedWindow': expected seconds from 0 (off) to 5"));
   CHECK_THAT(error_of(tmp.write("doubt.yaml", "%YAML:1.0\nTracking.StartDoubt: -1\n")),
              Contains("'Tracking.StartDoubt': expected seconds from 0 (off) to 60"));
   CHECK_THAT(error_of(tmp.write("refused.yaml", "%YAML:1.0\nTracking.RegisterRefusedSteps: 2\n")),

@@ -112,6 +112,57 @@ TEST_CASE("support: after a gap a car that was moving cannot have stayed put: it
   }
 }
 
+TEST_CASE("support: a run of steps each within reach can still slide the speed beyond a vehicle's reach",
+          "[tracking][support]") {
+  const rgbl::TrackerOptions options;  // 0.3 s window, 1 g
+  // 10 Hz at 9.5 m/s (0.95 m a frame) along z, then the steps of traffic seed 24 at nFeatures 1900
+  // on frames 9-10 (0.76, 0.41 m): each within check_step's 0.25 + 10 % + 0.05 m of the one before
+  std::vector<rgbl::PlacedCentre> recent;
+  for (int i = 0; i <= 8; ++i) recent.push_back({0.1 * i, Eigen::Vector3d(0.0, 0.0, 0.95 * i)});
+  const double z8 = 0.95 * 8;
+  recent.push_back({0.9, Eigen::Vector3d(0.0, 0.0, z8 + 0.76)});
+  // frame 10: anchor frame 7 (0.3 s back), the speed over frames 4-7 carries it to z7 + 2.85
+  const auto at10 = rgbl::check_speed(recent, 1.0, Eigen::Vector3d(0.0, 0.0, z8 + 0.76 + 0.41), options);
+  REQUIRE(at10);
+  CHECK(at10->frames_back == 3);
+  CHECK(at10->span_s == Approx(0.3));
+  CHECK(at10->velocity.z() == Approx(9.5));
+  CHECK(at10->expected_centre.z() == Approx(0.95 * 7 + 2.85));
+  const double allowed = 0.25 + 0.1 * 2.85 + 0.5 * 10.0 * 0.09;  // allowed_step(2.85 m, 0.3 s)
+  CHECK(at10->allowed_m == Approx(allowed));
+  CHECK(at10->deviation_m == Approx(0.95 * 7 + 2.85 - (z8 + 1.17)));  // 0.73 m: within the 0.99 m
+  CHECK(at10->plausible);
+  recent.push_back({1.0, Eigen::Vector3d(0.0, 0.0, z8 + 1.17)});
+  // frame 11 at 0.20 m more: 1.51 m short of the anchor's 2.85 m, beyond what braking at 1 g explains
+  const auto at11 = rgbl::check_speed(recent, 1.1, Eigen::Vector3d(0.0, 0.0, z8 + 1.37), options);
+  REQUIRE(at11);
+  CHECK(at11->deviation_m == Approx(z8 + 2.85 - (z8 + 1.37)));
+  CHECK_FALSE(at11->plausible);
+  // sideways by as much is as far out of reach, and the true 1.0 m step after the slide is within it
+  CHECK_FALSE(rgbl::check_speed(recent, 1.1, Eigen::Vector3d(1.48, 0.0, z8 + 2.85), options)->plausible);
+  CHECK(rgbl::check_speed(recent, 1.1, Eigen::Vector3d(0.0, 0.0, z8 + 2.17), options)->plausible);
+  // braking at 3.5 m/s^2 (the traffic scenario's stop) is well within reach
+  std::vector<rgbl::PlacedCentre> braking;
+  double z = 0.0, v = 9.5;
+  for (int i = 0; i <= 12; ++i) {
+    braking.push_back({0.1 * i, Eigen::Vector3d(0.0, 0.0, z)});
+    z += v * 0.1;
+    v -= 0.35;
+  }
+  const auto brake = rgbl::check_speed(braking, 1.3, Eigen::Vector3d(0.0, 0.0, z), options);
+  REQUIRE(brake);
+  CHECK(brake->deviation_m == Approx(0.315));  // 3 x 0.67 m against 0.60 + 0.565 + 0.53 m
+  CHECK(brake->plausible);
+  // nothing to say: too short a history, frames as far apart as the window (the step check's case), off
+  CHECK_FALSE(rgbl::check_speed(std::span(recent).first(2), 0.2, Eigen::Vector3d::Zero(), options));
+  std::vector<rgbl::PlacedCentre> slow;
+  for (int i = 0; i <= 5; ++i) slow.push_back({0.3 * i, Eigen::Vector3d(0.0, 0.0, 2.85 * i)});
+  CHECK_FALSE(rgbl::check_speed(slow, 1.8, Eigen::Vector3d(0.0, 0.0, 0.0), options));
+  rgbl::TrackerOptions off;
+  off.speed_window_s = 0.0;
+  CHECK_FALSE(rgbl::check_speed(recent, 1.1, Eigen::Vector3d::Zero(), off));
+}
+
 TEST_CASE("support: the thresholds are validated", "[tracking][support]") {
   rgbl::TrackerOptions options;
   options.min_ok_inliers = 5;  // below min_pose_inliers (10)
@@ -125,6 +176,9 @@ TEST_CASE("support: the thresholds are validated", "[tracking][support]") {
   options = {};
   options.start_doubt_s = -0.5;
   CHECK_THROWS_WITH(options.validate(), Catch::Contains("tracker.start_doubt_s"));
+  options = rgbl::TrackerOptions{};
+  options.speed_window_s = -0.1;
+  CHECK_THROWS_WITH(options.validate(), Catch::Contains("tracker.speed_window_s"));
   options = {};
   options.max_acceleration = -1.0;
   CHECK_THROWS_WITH(options.validate(), Catch::Contains("tracker.max_acceleration"));

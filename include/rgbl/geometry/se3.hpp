@@ -36,6 +36,8 @@ double rotation_angle(const Eigen::Matrix3d& R);
 double rotation_error(const Eigen::Matrix3d& R);
 
 Eigen::Isometry3d make_isometry(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+// The pose T_cam_world with rotation R_cam_world whose camera centre is `centre` (world): t = -R c.
+Eigen::Isometry3d pose_at_centre(const Eigen::Matrix3d& R_cam_world, const Eigen::Vector3d& centre);
 // T with its rotation replaced by the nearest rotation (to first order; through the unit quaternion).
 // Isometry3d::inverse() transposes: a pose off by 1e-7 (conjugated with KITTI's printed extrinsics)
 // and then composed with its own inverse, frame after frame, drifts off geometrically.

@@ -31,6 +31,8 @@
 //   refused placed by its scan, default 1),
 //   Tracking.StartDoubt (TrackerOptions::start_doubt_s: seconds after a start without velocity in which
 //   a contested step is taken when the keypoints without depth favour it, default 1, 0 = off),
+//   Tracking.SpeedWindow (TrackerOptions::speed_window_s: seconds over which the speed may not change
+//   faster than a vehicle's, the keypoints without depth deciding where it did, default 0.3, 0 = off),
 //   Tracking.RansacPointsNearPrior (TrackerOptions::ransac_max_points_near_prior: keypoints with depth in
 //   the frame-to-frame RANSAC near a constant-velocity prior, default 350; 1000 takes every one),
 //   Tracking.RansacPointsNearPriorRetry (TrackerOptions::ransac_max_points_near_prior_retry: keypoints
@@ -132,6 +134,7 @@ struct Settings {
   std::optional<bool> register_lost;                // Tracking.RegisterLost
   std::optional<bool> register_refused_steps;       // Tracking.RegisterRefusedSteps
   std::optional<double> start_doubt_s;              // Tracking.StartDoubt
+  std::optional<double> speed_window_s;             // Tracking.SpeedWindow
   std::optional<int> ransac_points_near_prior;      // Tracking.RansacPointsNearPrior
   std::optional<int> ransac_points_near_prior_retry;  // Tracking.RansacPointsNearPriorRetry
   std::optional<bool> depth_consistency;            // LocalMapping.DepthConsistency

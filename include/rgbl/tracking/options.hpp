@@ -165,6 +165,12 @@ struct TrackerOptions {
   double max_acceleration = 10.0;          // m/s^2, 1 g: more than a car brakes
   double step_tolerance_rotation_deg = 3.0;
   int min_jump_inliers = 50;
+  // The speed over a window: a frame's centre must also be within a vehicle's reach (allowed_step over
+  // the span) of where the mean velocity over speed_window_s before an anchor speed_window_s back
+  // carries it (check_speed). The step check bounds one step against the last, so a run of steps each
+  // within its tolerance can slide the speed down (or up) faster than a car brakes. Within one
+  // frame of the anchor it adds nothing; 0 = off. (docs/accuracy.md, "The speed over a window")
+  double speed_window_s = 0.3;
   // A velocity that stands on a start without one (a map's second frame, the frame after a loss or a
   // relocalisation) is in doubt for start_doubt_s seconds. Within them a contested step (refused for
   // the prediction although clearly more local-map inliers agree with it) is taken when the last

@@ -15,6 +15,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <span>
 
 namespace rgbl {
 
@@ -103,6 +104,34 @@ StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry
 // 23.6 m short at 11 m/s, is not within reach, though 23.6 m is within a dt^2 / 2 = 22 m + tolerance.
 StepCheck check_step(const Eigen::Isometry3d& T_cam_world, const Eigen::Isometry3d& T_cam_world_predicted,
                      const Eigen::Vector3d& last_centre, double dt, const TrackerOptions& options);
+
+// A camera centre at a time: the recent tracked frames that check_speed reads, oldest first.
+struct PlacedCentre {
+  double time = 0.0;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // world frame
+};
+
+// Where the speed before a window puts a frame, and whether the frame is within a vehicle's reach of
+// that. check_step bounds each step against the last one, so a run of steps each within its tolerance
+// can still change the speed faster than a vehicle can (a map pulled onto trucks at the ego speed
+// gives 0.76, 0.41, 0.20 m for true 1.0 m steps). Here the anchor is speed_window_s back: the mean
+// velocity over the window before the anchor, carried from the anchor to the frame's time.
+struct SpeedCheck {
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s, world frame, over the window before the anchor
+  Eigen::Vector3d expected_centre = Eigen::Vector3d::Zero();
+  double span_s = 0.0;       // from the anchor to the frame
+  std::size_t frames_back = 0;  // the anchor is this many entries before the frame
+  double deviation_m = 0.0;  // of the centre from expected_centre
+  double allowed_m = 0.0;    // allowed_step over the span
+  bool plausible = true;
+};
+
+// recent: consecutive tracked frames, oldest first, the last one the frame before `time`. The anchor is
+// the latest entry at least speed_window_s before `time` (90 %: timestamps jitter), the window before it
+// ends at the latest entry as far before the anchor. Empty when speed_window_s is 0, when the history is
+// too short or when the anchor is the last frame (check_step covers one frame's step).
+std::optional<SpeedCheck> check_speed(std::span<const PlacedCentre> recent, double time, const Eigen::Vector3d& centre,
+                                      const TrackerOptions& options);
 
 // The car's direction of travel in the camera's frame (the mount's yaw and pitch against the car's
 // axis), learned from tracked steps long enough to give a direction: each step in the camera frame
