@@ -101,6 +101,7 @@ void bind_tracking(py::module_& m) {
       .def_readonly("step_rejected", &TrackResult::step_rejected)
       .def_readonly("step_registered", &TrackResult::step_registered)
       .def_readonly("step_contested", &TrackResult::step_contested)
+      .def_readonly("speed_corrected", &TrackResult::speed_corrected)
       .def_readonly("start_refuted_since", &TrackResult::start_refuted_since)
       .def_readonly("gap", &TrackResult::gap)
       .def_readonly("gap_registered", &TrackResult::gap_registered)

@@ -174,6 +174,8 @@ std::string summary_json(const RunResult& run) {
   j["registered_rejected_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_registered; });
   // steps refused although clearly more inliers agreed with them than with the pose kept (weak frames)
   j["contested_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_contested; });
+  // frames placed by the speed before a slide faster than a vehicle brakes (TrackerOptions::speed_window_s)
+  j["speed_corrected_frames"] = run.frames_where([](const TrackResult& r) { return r.speed_corrected; });
   // [frame, the first frame placed on the start it refuted]
   j["refuted_starts"] = Json::array();
   for (const auto& f : run.frames) {
@@ -254,6 +256,11 @@ std::string summary_text(const RunResult& run) {
       fmt::format_to(out, "  start refuted at frame {} (the keypoints without depth fit its contested step): frames {}-{} "
                      "stay where the wrong start put them\n", r.frame_index, *r.start_refuted_since, r.frame_index - 1);
     }
+  }
+  const auto corrected = run.frames_where([](const TrackResult& r) { return r.speed_corrected; });
+  if (!corrected.empty()) {
+    fmt::format_to(out, "  frame(s) where the speed had slid faster than a vehicle brakes, placed by the speed before it "
+                   "(the keypoints without depth agreeing): {}\n", fmt::join(corrected, ", "));
   }
   const auto placed = run.frames_where([](const TrackResult& r) { return r.lost_registered; });
   if (!placed.empty()) {

@@ -456,7 +456,12 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   const double dt = h.frame.timestamp - last_frame_->timestamp;
   const Eigen::Vector3d last_centre = prediction.T_last_world.inverse().translation();
   const StepCheck step = check_step(h.frame.T_cam_world, prediction.T_cam_world, last_centre, dt, options_);
-  if (step.plausible) return h;
+  if (step.plausible) {
+    const std::optional<SpeedCheck> speed =
+        check_speed(recent_, h.frame.timestamp, h.frame.T_cam_world.inverse().translation(), options_);
+    if (!speed || speed->plausible) return h;
+    return speed_hypothesis(std::move(h), prediction, *speed, views);
+  }
   Frame candidate = h.frame;
   candidate.T_cam_world = prediction.T_cam_world;
   clear_matches(candidate);
@@ -542,26 +547,91 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   // hold, decide a contested step there. Traffic seed 13 starts standing among trucks at its speed and
   // at frame 5 (0.4 s) 57 of them fit the true 1.0 m step alone, 5 the prediction; seed 22, started
   // right, has its steps contested by the trucks at frames 4-7 and 1-3 fit those alone, 7-20 the prediction.
-  if (h.step_contested && start_ && h.frame.timestamp - start_->time <= options_.start_doubt_s) {
+  // A velocity that changed faster than a vehicle can is in doubt too: the prediction is beyond
+  // reach of where the speed over a window puts the frame (check_speed), the steps before it slid.
+  const bool start_doubt = start_ && h.frame.timestamp - start_->time <= options_.start_doubt_s;
+  const std::optional<SpeedCheck> slid =
+      h.step_contested && !start_doubt
+          ? check_speed(recent_, h.frame.timestamp, prediction.T_cam_world.inverse().translation(), options_)
+          : std::nullopt;
+  // ...and then only a step within reach of that speed is a candidate: vehicles passing faster than
+  // the car look like it backing up, to the images as to the scans (traffic seed 24 at nFeatures 1900,
+  // frame 12: a step 0.2 m back that 102 keypoints without depth fit, against 36 for the prediction)
+  const bool speed_doubt = slid && !slid->plausible &&
+                           check_speed(recent_, h.frame.timestamp, h.frame.T_cam_world.inverse().translation(), options_)
+                               ->plausible;
+  if (h.step_contested && (start_doubt || speed_doubt)) {
     const Eigen::Isometry3d T_world_last = last_frame_->T_cam_world.inverse();
-    // a: the step, b: the prediction
+    // a: the step, b: the prediction; for a slid speed the prediction at the step's rotation: the
+    // question is the speed, and the far points, which fit one rotation, would otherwise outvote it
+    const Eigen::Isometry3d T_b = speed_doubt ? pose_at_centre(h.frame.T_cam_world.linear(),
+                                                                prediction.T_cam_world.inverse().translation())
+                                              : prediction.T_cam_world;
     const RayFits fits = fits_by_rays(camera_, *last_frame_, h.frame, h.frame.T_cam_world * T_world_last,
-                                      prediction.T_cam_world * T_world_last, options_.motion_max_hamming,
+                                      T_b * T_world_last, options_.motion_max_hamming,
                                       map_.options().scale_factor);
     const bool take = count_preference(fits.a_only, fits.b_only, 3.0) < 0;
+    const std::string why =
+        start_doubt ? fmt::format("{:.2f} s after a start without velocity", h.frame.timestamp - start_->time)
+                    : fmt::format("the prediction {:.2f} m from where the speed over the {:.2f} s before frame {} puts "
+                                  "it (allowed {:.2f} m)", slid->deviation_m, options_.speed_window_s,
+                                  h.frame.index - slid->frames_back, slid->allowed_m);
     logger()->log(take ? spdlog::level::warn : spdlog::level::debug,
-                  "frame {}: {:.2f} s after a start without velocity, the keypoints without depth fit the contested "
-                  "step alone {} times, the prediction alone {}: {}", h.frame.index,
-                  h.frame.timestamp - start_->time, fits.a_only, fits.b_only,
-                  take ? "the step is taken (the start was wrong)" : "kept at the prediction");
+                  "frame {}: {}, the keypoints without depth fit the contested step alone {} times, the prediction "
+                  "alone {}: {}", h.frame.index, why, fits.a_only, fits.b_only,
+                  take ? (start_doubt ? "the step is taken (the start was wrong)" : "the step is taken (the velocity slid)")
+                       : "kept at the prediction");
     if (take) {
       h.jump = true;  // reported as a step beyond a vehicle's reach, and weak (contested)
-      h.start_refuted = true;
+      h.start_refuted = start_doubt;
+      h.speed_corrected = !start_doubt;
       h.reference = step_reference;
       return h;
     }
   }
   settle(h, std::move(candidate), plausible_alternative, prediction.T_cam_world, candidate_views, views);
+  return h;
+}
+
+Tracker::Hypothesis Tracker::speed_hypothesis(Hypothesis h, const Prediction& prediction, const SpeedCheck& speed,
+                                               ViewLog& views) const {
+  Frame candidate = h.frame;
+  // the prediction's rotation, the centre where the speed puts it
+  candidate.T_cam_world = pose_at_centre(prediction.T_cam_world.linear(), speed.expected_centre);
+  clear_matches(candidate);
+  ViewLog candidate_views;
+  const LocalMapResult from_speed = track_local_map(candidate, h.reference, h.relocalisation_frame, candidate_views);
+  const std::optional<SpeedCheck> again =
+      check_speed(recent_, candidate.timestamp, candidate.T_cam_world.inverse().translation(), options_);
+  RayFits fits;
+  bool take = from_speed.ok && again && again->plausible;
+  if (take) {
+    // Either may be on vehicles: the speed's pose decides only where the keypoints without depth, the
+    // scene beyond the LiDAR's reach, fit it clearly more often than the step (a: the step).
+    const Eigen::Isometry3d T_world_last = last_frame_->T_cam_world.inverse();
+    // (at the step's rotation: the question is the speed, see step_hypothesis)
+    const Eigen::Isometry3d T_b =
+        pose_at_centre(h.frame.T_cam_world.linear(), candidate.T_cam_world.inverse().translation());
+    fits = fits_by_rays(camera_, *last_frame_, h.frame, h.frame.T_cam_world * T_world_last,
+                        T_b * T_world_last, options_.motion_max_hamming,
+                        map_.options().scale_factor);
+    take = count_preference(fits.a_only, fits.b_only, 3.0) > 0;
+  }
+  logger()->log(take ? spdlog::level::warn : spdlog::level::debug,
+                "frame {}: {:.2f} m from where the speed over the {:.2f} s before frame {} puts it (allowed {:.2f} m, "
+                "{:.1f} m/s) on {} inliers; from there the local map finds {} ({:.2f} m off); the keypoints without "
+                "depth fit the step alone {} times, that pose alone {}: {}",
+                h.frame.index, speed.deviation_m, options_.speed_window_s, h.frame.index - speed.frames_back,
+                speed.allowed_m, speed.velocity.norm(), h.inliers, from_speed.inliers,
+                again ? again->deviation_m : -1.0, fits.a_only, fits.b_only, take ? "taken" : "the step kept");
+  if (!take) return h;
+  h.reference = from_speed.reference;
+  h.speed_placed = speed.velocity;
+  h.speed_corrected = true;
+  // clearly more inliers on the step than where the speed puts the frame: weak, as a contested step
+  h.step_contested = count_preference(static_cast<std::size_t>(from_speed.inliers),
+                                      static_cast<std::size_t>(h.inliers), 2.0) > 0;
+  settle(h, std::move(candidate), true, prediction.T_cam_world, candidate_views, views);
   return h;
 }
 
@@ -634,6 +704,7 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
   outcome.step_registered = h.step_registered;
   outcome.step_contested = h.step_contested;
   if (h.start_refuted) outcome.start_refuted_since = start_->frame;
+  outcome.speed_corrected = h.speed_corrected;
   outcome.gap = prediction.gap;
   outcome.gap_registered = prediction.registered;
   int inliers = h.inliers;
@@ -648,6 +719,23 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
     if (last_frame_ && (!h.step_rejected || h.step_registered)) {
       velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
       velocity_dt_ = frame.timestamp - last_frame_->timestamp;
+      if (h.speed_placed) {
+        // the step from the last frame carries that frame's error; the window's speed is the velocity
+        const Eigen::Isometry3d T_last_world = pose_at_centre(
+            last_frame_->T_cam_world.linear(), frame.T_cam_world.inverse().translation() - *h.speed_placed * velocity_dt_);
+        velocity_ = frame.T_cam_world * T_last_world.inverse();
+      }
+    }
+    const PlacedCentre placed{frame.timestamp, frame.T_cam_world.inverse().translation()};
+    if (consecutive && !h.relocalised && !h.jump && !prediction.gap) {
+      recent_.push_back(placed);
+      // what check_speed reads: two windows back, and a frame more
+      const auto stale = std::find_if(recent_.begin(), recent_.end(), [&](const PlacedCentre& p) {
+        return frame.timestamp - p.time <= 2.5 * options_.speed_window_s;
+      });
+      if (stale - recent_.begin() > 1) recent_.erase(recent_.begin(), stale - 1);
+    } else {
+      recent_.assign(1, placed);
     }
     // a velocity set without a steady one before it stands on this frame's start alone
     if (!velocity_steady_ && !h.step_rejected) start_ = Start{frame.timestamp, frame.index};
@@ -659,7 +747,7 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
       // alongside at the ego speed (traffic seed 27, frame 2: 1.0 m tracked at frame 1, 0.04 m at
       // frame 2, and standing still for the rest of the run, 7.5 m off).
       velocity_steady_ = consecutive && !h.relocalised;
-      if (consecutive && !h.relocalised && !h.jump) travel_.add(last_frame_->T_cam_world, frame.T_cam_world, options_);
+      if (consecutive && !h.relocalised && !h.jump && !h.speed_placed) travel_.add(last_frame_->T_cam_world, frame.T_cam_world, options_);
     }
     // a frame placed at the prediction has no observations worth a keyframe; a full mapping queue
     // takes none (those waiting refresh the map soon)
@@ -674,6 +762,7 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
                     first.relocalisation_tried || !first.motion_ok ? ", no relocalisation in the map" : "");
     state_ = TrackState::Lost;
     velocity_steady_ = false;
+    recent_.clear();
     inliers = 0;
     last_inliers_ = 0;
     frame.T_cam_world = prediction.T_cam_world;  // best guess, reported with state Lost
@@ -725,6 +814,7 @@ TrackerOutcome& Tracker::finish_initialised(const Frame& frame, TrackerOutcome& 
   last_frame_ = frame;
   last_frame_->grid = FeatureGrid();
   last_tracked_frame_.reset();
+  recent_.assign(1, PlacedCentre{frame.timestamp, frame.T_cam_world.inverse().translation()});
   return outcome;
 }
 

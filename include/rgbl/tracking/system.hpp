@@ -73,6 +73,9 @@ struct TrackResult {
   // a contested step taken within TrackerOptions::start_doubt_s of a start without velocity: the start
   // was wrong, and the frames from this one (its index) up to this frame were placed on it
   std::optional<std::size_t> start_refuted_since;
+  // the speed had changed faster than a vehicle can over TrackerOptions::speed_window_s, and the
+  // keypoints without depth took a pose within reach of the speed before (ok unless contested too)
+  bool speed_corrected = false;
   // the first frame after a gap in the timestamps, its scan registered onto the last frame's
   // (TrackerOptions::register_gaps); gap_registered: the registration was accepted as the prediction
   bool gap = false;

@@ -43,6 +43,9 @@ struct TrackerOutcome {
   // A contested step taken within start_doubt_s of a start without velocity: the start was wrong, and
   // the frames since this index were placed on it (they stay where they are).
   std::optional<std::size_t> start_refuted_since;
+  // The speed had changed faster than a vehicle can (check_speed over TrackerOptions::speed_window_s)
+  // and the keypoints without depth took the frame's pose within reach of the speed before the slide.
+  bool speed_corrected = false;
   // The first frame after a gap in the frames (TrackerOptions::register_gaps): its scan was registered
   // onto the last frame's; gap_registered: accepted, the registration was the prediction.
   bool gap = false;
@@ -76,6 +79,7 @@ class Tracker {
   // Returns that move as D (a frame's T_cam_world becomes T_cam_world * D); nullopt without a reference.
   std::optional<Eigen::Isometry3d> follow_map_correction(const Eigen::Isometry3d& T_ref_world_before);
 
+
   TrackState state() const { return state_; }
   KeyframeId reference_keyframe() const { return reference_; }
   // Constant-velocity motion T_cur_last of the last tracked frame pair, if any.
@@ -108,6 +112,10 @@ class Tracker {
     // weak, but no keyframe for it (the frame adds nothing the map lacks, its pose is the one in doubt)
     bool step_contested = false;
     bool start_refuted = false;  // ...taken, within start_doubt_s of a start (start_)
+    // a step within reach of the last one but not of the speed over a window (check_speed): placed
+    // where the local map searched from the window's prediction ends; that velocity is kept
+    std::optional<Eigen::Vector3d> speed_placed;  // the window's velocity, m/s in the world frame
+    bool speed_corrected = false;  // ...or a contested step taken because the velocity slid (check_speed)
     int inliers = 0;
     KeyframeId reference;                   // the reference keyframe it leaves
     std::size_t relocalisation_frame = 0;   // the last relocalisation, this frame's if it made one
@@ -183,6 +191,10 @@ class Tracker {
   // instead, else relocalisation (unless tried already), else the frame placed at the prediction.
   Hypothesis step_hypothesis(Hypothesis h, const Prediction& prediction, bool relocalisation_tried,
                              ViewLog& views) const;
+  // A step within reach of the last one that the speed over a window refutes (speed): the local map
+  // searched from where that speed puts the frame instead, taken when it ends within reach of it there.
+  Hypothesis speed_hypothesis(Hypothesis h, const Prediction& prediction, const SpeedCheck& speed,
+                              ViewLog& views) const;
   // Makes the chosen hypothesis the tracker's state (the only place track() changes it).
   void commit(Hypothesis& h, const Prediction& prediction, const FirstHypothesis& first, const ViewLog& views,
               bool mapping_idle, std::size_t keyframes_queued, TrackerOutcome& outcome);
@@ -278,6 +290,7 @@ class Tracker {
     std::size_t frame = 0;
   };
   std::optional<Start> start_;
+  std::vector<PlacedCentre> recent_;  // consecutive tracked frames since the last start, jump or gap (check_speed)
 };
 
 }  // namespace rgbl
