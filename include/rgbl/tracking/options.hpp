@@ -168,8 +168,11 @@ struct TrackerOptions {
   // The speed over a window: a frame's centre must also be within a vehicle's reach (allowed_step over
   // the span) of where the mean velocity over speed_window_s before an anchor speed_window_s back
   // carries it (check_speed). The step check bounds one step against the last, so a run of steps each
-  // within its tolerance can slide the speed down (or up) faster than a car brakes. Within one
-  // frame of the anchor it adds nothing; 0 = off. (docs/accuracy.md, "The speed over a window")
+  // within its tolerance can slide the speed down (or up) faster than a car brakes. A frame beyond
+  // that reach is searched again from where the window's speed puts it, and placed there when the
+  // last frame's keypoints without depth fit that clearly more often than the step (as for
+  // start_doubt_s); the window's speed is then the velocity. Within one frame of the anchor it adds
+  // nothing; 0 = off. (docs/accuracy.md, "The speed over a window")
   double speed_window_s = 0.3;
   // A velocity that stands on a start without one (a map's second frame, the frame after a loss or a
   // relocalisation) is in doubt for start_doubt_s seconds. Within them a contested step (refused for

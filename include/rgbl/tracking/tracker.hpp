@@ -115,7 +115,6 @@ class Tracker {
     // a step within reach of the last one but not of the speed over a window (check_speed): placed
     // where the local map searched from the window's prediction ends; that velocity is kept
     std::optional<Eigen::Vector3d> speed_placed;  // the window's velocity, m/s in the world frame
-    bool speed_corrected = false;  // ...or a contested step taken because the velocity slid (check_speed)
     int inliers = 0;
     KeyframeId reference;                   // the reference keyframe it leaves
     std::size_t relocalisation_frame = 0;   // the last relocalisation, this frame's if it made one
