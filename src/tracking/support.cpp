@@ -113,7 +113,7 @@ std::optional<SpeedCheck> check_speed(std::span<const PlacedCentre> recent, doub
   check.expected_centre = a.centre + check.velocity * check.span_s;
   check.deviation_m = (centre - check.expected_centre).norm();
   check.allowed_m = allowed_step(check.velocity.norm() * check.span_s, check.span_s, options);
-  check.plausible = check.deviation_m <= check.allowed_m;
+  check.plausible = check.reaches(centre);
   return check;
 }
 

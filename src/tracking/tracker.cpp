@@ -22,6 +22,12 @@ namespace rgbl {
 
 namespace {
 
+// Clearly more inliers on a step than on the pose kept instead: two sigmas of the counts' difference,
+// each count taken as Poisson (a few inliers either way are a tie).
+bool clearly_more(int step_inliers, int kept_inliers) {
+  return count_preference(static_cast<std::size_t>(kept_inliers), static_cast<std::size_t>(step_inliers), 2.0) > 0;
+}
+
 // The frame's observations as a new keyframe (landmark links are added by the caller).
 Keyframe keyframe_from(const Frame& frame, const TrackerOptions& options) {
   Keyframe kf;
@@ -462,12 +468,9 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
     if (!speed || speed->plausible) return h;
     return speed_hypothesis(std::move(h), prediction, *speed, views);
   }
-  Frame candidate = h.frame;
-  candidate.T_cam_world = prediction.T_cam_world;
-  clear_matches(candidate);
-  ViewLog candidate_views;
-  const LocalMapResult from_prediction =
-      track_local_map(candidate, h.reference, h.relocalisation_frame, candidate_views);
+  Search search = search_from(h.frame, prediction.T_cam_world, h.reference, h.relocalisation_frame);
+  const Frame& candidate = search.frame;
+  const LocalMapResult& from_prediction = search.local;
   const StepCheck candidate_step =
       check_step(candidate.T_cam_world, prediction.T_cam_world, last_centre, dt, options_);
   const bool plausible_alternative = from_prediction.ok && candidate_step.plausible;
@@ -536,8 +539,7 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
   // inliers on the true 1.0 m steps against 196-221 at the prediction, standing still). Clearly: by
   // two sigmas of the counts' difference, each count taken as Poisson (sigma sqrt(a + b)); a few
   // inliers either way are a tie (traffic seed 3 at the lights: 252 against 246).
-  h.step_contested = plausible_alternative && count_preference(static_cast<std::size_t>(from_prediction.inliers),
-                                                               static_cast<std::size_t>(h.inliers), 2.0) > 0;
+  h.step_contested = plausible_alternative && clearly_more(h.inliers, from_prediction.inliers);
   if (h.step_contested) {
     logger()->debug("frame {}: kept at the prediction on {} inliers against a step with {}: weak", h.frame.index,
                     from_prediction.inliers, h.inliers);
@@ -566,22 +568,19 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
       return h;
     }
   }
-  settle(h, std::move(candidate), plausible_alternative, prediction.T_cam_world, candidate_views, views);
+  settle(h, std::move(search), plausible_alternative, prediction.T_cam_world, views);
   return h;
 }
 
 Tracker::Hypothesis Tracker::speed_hypothesis(Hypothesis h, const Prediction& prediction, const SpeedCheck& speed,
                                                ViewLog& views) const {
-  Frame candidate = h.frame;
   // the prediction's rotation, the centre where the speed puts it
-  candidate.T_cam_world = pose_at_centre(prediction.T_cam_world.linear(), speed.expected_centre);
-  clear_matches(candidate);
-  ViewLog candidate_views;
-  const LocalMapResult from_speed = track_local_map(candidate, h.reference, h.relocalisation_frame, candidate_views);
-  const std::optional<SpeedCheck> again =
-      check_speed(recent_, candidate.timestamp, candidate.T_cam_world.inverse().translation(), options_);
+  Search search = search_from(h.frame, pose_at_centre(prediction.T_cam_world.linear(), speed.expected_centre),
+                              h.reference, h.relocalisation_frame);
+  const LocalMapResult& from_speed = search.local;
+  const Eigen::Vector3d found_centre = search.frame.T_cam_world.inverse().translation();
   RayFits fits;
-  bool take = from_speed.ok && again && again->plausible;
+  bool take = from_speed.ok && speed.reaches(found_centre);
   if (take) {
     // Either may be on vehicles: the speed's pose decides only where the keypoints without depth, the
     // scene beyond the LiDAR's reach, fit it clearly more often than the step (a: the step). Both
@@ -589,8 +588,7 @@ Tracker::Hypothesis Tracker::speed_hypothesis(Hypothesis h, const Prediction& pr
     // only, would decide it by the rotation (traffic seed 22 at nFeatures 2100, frame 7: 21 against
     // 11 at their own rotations; frame 8 at one rotation: 1 against 73).
     const Eigen::Isometry3d T_world_last = last_frame_->T_cam_world.inverse();
-    const Eigen::Isometry3d T_b =
-        pose_at_centre(h.frame.T_cam_world.linear(), candidate.T_cam_world.inverse().translation());
+    const Eigen::Isometry3d T_b = pose_at_centre(h.frame.T_cam_world.linear(), found_centre);
     fits = fits_by_rays(camera_, *last_frame_, h.frame, h.frame.T_cam_world * T_world_last,
                         T_b * T_world_last, options_.motion_max_hamming,
                         map_.options().scale_factor);
@@ -602,23 +600,31 @@ Tracker::Hypothesis Tracker::speed_hypothesis(Hypothesis h, const Prediction& pr
                 "depth fit the step alone {} times, that pose alone {}: {}",
                 h.frame.index, speed.deviation_m, options_.speed_window_s, h.frame.index - speed.frames_back,
                 speed.allowed_m, speed.velocity.norm(), h.inliers, from_speed.inliers,
-                again ? again->deviation_m : -1.0, fits.a_only, fits.b_only, take ? "taken" : "the step kept");
+                (found_centre - speed.expected_centre).norm(), fits.a_only, fits.b_only,
+                take ? "taken" : "the step kept");
   if (!take) return h;
   h.reference = from_speed.reference;
   h.speed_placed = speed.velocity;
   // clearly more inliers on the step than where the speed puts the frame: weak, as a contested step
-  h.step_contested = count_preference(static_cast<std::size_t>(from_speed.inliers),
-                                      static_cast<std::size_t>(h.inliers), 2.0) > 0;
-  settle(h, std::move(candidate), true, prediction.T_cam_world, candidate_views, views);
+  h.step_contested = clearly_more(h.inliers, from_speed.inliers);
+  settle(h, std::move(search), true, prediction.T_cam_world, views);
   return h;
 }
 
-void Tracker::settle(Hypothesis& h, Frame candidate, bool take, const Eigen::Isometry3d& T_cam_world,
-                     const ViewLog& candidate_views, ViewLog& views) {
-  views.visible.insert(views.visible.end(), candidate_views.visible.begin(), candidate_views.visible.end());
-  views.found.insert(views.found.end(), candidate_views.found.begin(), candidate_views.found.end());
+Tracker::Search Tracker::search_from(const Frame& frame, const Eigen::Isometry3d& T_cam_world, KeyframeId reference,
+                                     std::size_t relocalisation_frame) const {
+  Search s{frame, {}, {}};
+  s.frame.T_cam_world = T_cam_world;
+  clear_matches(s.frame);
+  s.local = track_local_map(s.frame, reference, relocalisation_frame, s.views);
+  return s;
+}
+
+void Tracker::settle(Hypothesis& h, Search search, bool take, const Eigen::Isometry3d& T_cam_world, ViewLog& views) {
+  views.visible.insert(views.visible.end(), search.views.visible.begin(), search.views.visible.end());
+  views.found.insert(views.found.end(), search.views.found.begin(), search.views.found.end());
   if (take) {
-    h.frame = std::move(candidate);
+    h.frame = std::move(search.frame);
     h.inliers = count_tracked(h.frame);
     h.weak = false;
   } else {
@@ -639,12 +645,9 @@ Tracker::Hypothesis Tracker::gap_hypothesis(Hypothesis h, const Prediction& pred
   };
   const StepCheck taken = off(h.frame.T_cam_world);
   if (within(taken)) return h;
-  Frame candidate = h.frame;
-  candidate.T_cam_world = prediction.T_cam_world;
-  clear_matches(candidate);
-  ViewLog candidate_views;
-  const LocalMapResult local = track_local_map(candidate, h.reference, last_relocalisation_frame_, candidate_views);
-  const bool agrees = local.ok && within(off(candidate.T_cam_world));
+  Search search = search_from(h.frame, prediction.T_cam_world, h.reference, last_relocalisation_frame_);
+  const LocalMapResult& local = search.local;
+  const bool agrees = local.ok && within(off(search.frame.T_cam_world));
   logger()->warn("frame {}: {}placed {:.2f} m / {:.1f} deg from the scans' registration across the gap (at most "
                  "{:.2f} m / {:.1f} deg) on {} inliers; from the registration the local map finds {} of {}: {}",
                  h.frame.index, h.relocalised ? "relocalised, " : "", taken.translation_m, taken.rotation_deg,
@@ -654,7 +657,7 @@ Tracker::Hypothesis Tracker::gap_hypothesis(Hypothesis h, const Prediction& pred
   h.reference = local.reference;
   h.relocalised = false;
   h.relocalisation_frame = last_relocalisation_frame_;
-  settle(h, std::move(candidate), agrees, prediction.T_cam_world, candidate_views, views);
+  settle(h, std::move(search), agrees, prediction.T_cam_world, views);
   return h;
 }
 
@@ -695,14 +698,14 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
     // a refused step placed at the prediction keeps the velocity; placed by its scan, the scans
     // measured the motion where the images could not, and it becomes the velocity
     if (last_frame_ && (!h.step_rejected || h.step_registered)) {
-      velocity_ = frame.T_cam_world * last_frame_->T_cam_world.inverse();
       velocity_dt_ = frame.timestamp - last_frame_->timestamp;
-      if (h.speed_placed) {
-        // the step from the last frame carries that frame's error; the window's speed is the velocity
-        const Eigen::Isometry3d T_last_world = pose_at_centre(
-            last_frame_->T_cam_world.linear(), frame.T_cam_world.inverse().translation() - *h.speed_placed * velocity_dt_);
-        velocity_ = frame.T_cam_world * T_last_world.inverse();
-      }
+      // placed by the speed over a window: the step from the last frame carries that frame's error,
+      // so the last frame is taken where the window's speed puts it
+      const Eigen::Isometry3d T_last_world =
+          h.speed_placed ? pose_at_centre(last_frame_->T_cam_world.linear(),
+                                          frame.T_cam_world.inverse().translation() - *h.speed_placed * velocity_dt_)
+                         : last_frame_->T_cam_world;
+      velocity_ = frame.T_cam_world * T_last_world.inverse();
     }
     const PlacedCentre placed{frame.timestamp, frame.T_cam_world.inverse().translation()};
     if (consecutive && !h.relocalised && !h.jump && !prediction.gap) {

@@ -123,7 +123,9 @@ struct SpeedCheck {
   std::size_t frames_back = 0;  // the anchor is this many entries before the frame
   double deviation_m = 0.0;  // of the centre from expected_centre
   double allowed_m = 0.0;    // allowed_step over the span
-  bool plausible = true;
+  bool plausible = true;     // reaches(the centre checked)
+  // Another centre at the same time within the vehicle's reach of expected_centre.
+  bool reaches(const Eigen::Vector3d& centre) const { return (centre - expected_centre).norm() <= allowed_m; }
 };
 
 // recent: consecutive tracked frames, oldest first, the last one the frame before `time`. The anchor is

@@ -155,10 +155,18 @@ class Tracker {
   // A pose after a gap further from the registered prediction than the gap tolerance: the local map
   // searched from the registration instead, else the frame weak at the registered pose.
   Hypothesis gap_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const;
-  // The end of both: the frame as the local-map search from a pose left it (candidate, that search's
-  // views in candidate_views) when `take`, else weak at T_cam_world without matches.
-  static void settle(Hypothesis& h, Frame candidate, bool take, const Eigen::Isometry3d& T_cam_world,
-                     const ViewLog& candidate_views, ViewLog& views);
+  // The local map searched for a copy of `frame` from T_cam_world, its matches cleared first: the
+  // alternative pose that the step, speed and gap checks weigh against the frame's own.
+  struct Search {
+    Frame frame;
+    ViewLog views;
+    LocalMapResult local;
+  };
+  Search search_from(const Frame& frame, const Eigen::Isometry3d& T_cam_world, KeyframeId reference,
+                     std::size_t relocalisation_frame) const;
+  // The end of those checks: the frame as the search left it when `take`, else weak at T_cam_world
+  // without matches; the search's views are counted either way.
+  static void settle(Hypothesis& h, Search search, bool take, const Eigen::Isometry3d& T_cam_world, ViewLog& views);
   FirstHypothesis first_hypothesis(Frame frame, const Prediction& prediction, ViewLog& views) const;
   // Relocalisation against the whole map, independent of any prediction, confirmed on the local map.
   Hypothesis relocalisation_hypothesis(Frame frame, KeyframeId reference, ViewLog& views) const;
@@ -191,7 +199,8 @@ class Tracker {
   Hypothesis step_hypothesis(Hypothesis h, const Prediction& prediction, bool relocalisation_tried,
                              ViewLog& views) const;
   // A step within reach of the last one that the speed over a window refutes (speed): the local map
-  // searched from where that speed puts the frame instead, taken when it ends within reach of it there.
+  // searched from where that speed puts the frame instead, taken when it ends within the window's
+  // reach and the keypoints without depth fit it clearly more often than the step.
   Hypothesis speed_hypothesis(Hypothesis h, const Prediction& prediction, const SpeedCheck& speed,
                               ViewLog& views) const;
   // Makes the chosen hypothesis the tracker's state (the only place track() changes it).
