@@ -425,6 +425,8 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.register_gaps = flag("Tracking.RegisterGaps");
   s.register_lost = flag("Tracking.RegisterLost");
   s.register_refused_steps = flag("Tracking.RegisterRefusedSteps");
+  s.road_start = flag("Tracking.RoadStart");
+  s.start_by_rays = flag("Tracking.StartByRays");
   s.start_doubt_s = r.number({"Tracking.StartDoubt"});
   if (s.start_doubt_s && !(*s.start_doubt_s >= 0.0 && *s.start_doubt_s <= 60.0))
     r.fail("Tracking.StartDoubt", "seconds from 0 (off) to 60");

@@ -176,6 +176,8 @@ std::string summary_json(const RunResult& run) {
   j["contested_step_frames"] = run.frames_where([](const TrackResult& r) { return r.step_contested; });
   // frames placed by the speed before a slide faster than a vehicle brakes (TrackerOptions::speed_window_s)
   j["speed_corrected_frames"] = run.frames_where([](const TrackResult& r) { return r.speed_corrected; });
+  // starts chosen by the keypoints without depth against the road and the inliers
+  j["rays_start_frames"] = run.frames_where([](const TrackResult& r) { return r.start_by_rays; });
   // [frame, the first frame placed on the start it refuted]
   j["refuted_starts"] = Json::array();
   for (const auto& f : run.frames) {
@@ -256,6 +258,11 @@ std::string summary_text(const RunResult& run) {
       fmt::format_to(out, "  start refuted at frame {} (the keypoints without depth fit its contested step): frames {}-{} "
                      "stay where the wrong start put them\n", r.frame_index, *r.start_refuted_since, r.frame_index - 1);
     }
+  }
+  const auto by_rays = run.frames_where([](const TrackResult& r) { return r.start_by_rays; });
+  if (!by_rays.empty()) {
+    fmt::format_to(out, "  start(s) chosen by the keypoints without depth against the road and the inliers (the scale "
+                   "unchecked until a contested step): {}\n", fmt::join(by_rays, ", "));
   }
   const auto corrected = run.frames_where([](const TrackResult& r) { return r.speed_corrected; });
   if (!corrected.empty()) {

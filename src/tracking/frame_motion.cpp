@@ -194,19 +194,28 @@ std::size_t subset_stride(std::size_t with_depth, std::size_t max_points) {
   return std::max<std::size_t>(1, (with_depth + max_points - 1) / max_points);
 }
 
-// estimate_frame_motion on every stride-th current keypoint with depth.
+// Which keypoints of a frame a RANSAC reads: those with depth, and of them those `only` marks (if set).
+struct KeypointFilter {
+  const std::vector<bool>* only = nullptr;
+  bool operator()(const Frame& f, std::size_t i) const {
+    return f.depth_sigma[i] > 0.0F && (only == nullptr || (*only)[i]);
+  }
+};
+
+// estimate_frame_motion on every stride-th current keypoint the filter takes.
 std::optional<Eigen::Isometry3d> estimate_on_subset(const PinholeCamera& camera, const Frame& last, const Frame& frame,
                                                     const TrackerOptions& options,
                                                     const std::optional<Eigen::Isometry3d>& prior,
                                                     std::vector<bool>* moving, std::optional<RivalMotion>* rival,
-                                                    std::size_t stride) {
+                                                    std::size_t stride, KeypointFilter last_filter = {},
+                                                    KeypointFilter cur_filter = {}) {
   if (rival != nullptr) rival->reset();
   std::vector<Descriptor> last_desc, cur_desc;
   std::vector<Eigen::Vector3d> last_pts, cur_pts;
   std::vector<int> cur_cell;  // coverage cell of each current point
   std::vector<std::size_t> cur_keypoint;  // keypoint index of each current point
   for (std::size_t i = 0; i < last.size(); ++i) {
-    if (last.depth_sigma[i] <= 0.0F) continue;
+    if (!last_filter(last, i)) continue;
     last_desc.push_back(last.descriptors[i]);
     last_pts.push_back(camera.unproject(Eigen::Vector2d(last.keypoints[i].x, last.keypoints[i].y), last.depth[i]));
   }
@@ -223,7 +232,7 @@ std::optional<Eigen::Isometry3d> estimate_on_subset(const PinholeCamera& camera,
   };
   std::size_t seen = 0;
   for (std::size_t i = 0; i < frame.size(); ++i) {
-    if (frame.depth_sigma[i] <= 0.0F) continue;
+    if (!cur_filter(frame, i)) continue;
     if (seen++ % stride != 0) continue;
     cur_desc.push_back(frame.descriptors[i]);
     cur_pts.push_back(camera.unproject(Eigen::Vector2d(frame.keypoints[i].x, frame.keypoints[i].y), frame.depth[i]));
@@ -439,6 +448,19 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
     T = estimate_on_subset(camera, last, frame, options, prior, moving, rival, retry);
   }
   return T;
+}
+
+std::optional<Eigen::Isometry3d> estimate_road_motion(const PinholeCamera& camera, const Frame& last, const Frame& frame,
+                                                      const TrackerOptions& options) {
+  const std::vector<bool> last_road = ground_keypoints(camera, last, options);
+  const std::vector<bool> road = ground_keypoints(camera, frame, options);
+  if (last_road.empty() || road.empty()) return std::nullopt;
+  const auto on_road = static_cast<std::size_t>(std::count(road.begin(), road.end(), true));
+  TrackerOptions guess = options;
+  guess.ransac_min_inliers = options.ransac_guess_min_inliers;
+  return estimate_on_subset(camera, last, frame, guess, std::nullopt, nullptr, nullptr,
+                            subset_stride(on_road, options.ransac_max_points), KeypointFilter{&last_road},
+                            KeypointFilter{&road});
 }
 
 RayFits fits_by_rays(const PinholeCamera& camera, const Frame& last, const Frame& frame, const Eigen::Isometry3d& T_a,

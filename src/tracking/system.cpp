@@ -389,6 +389,7 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   result.step_contested = outcome.step_contested;
   result.start_refuted_since = outcome.start_refuted_since;
   result.speed_corrected = outcome.speed_corrected;
+  result.start_by_rays = outcome.start_by_rays;
   result.gap = outcome.gap;
   result.gap_registered = outcome.gap_registered;
   result.lost_registered = outcome.lost_registered;

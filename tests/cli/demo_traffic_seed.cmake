@@ -20,14 +20,29 @@
 #   refused step than with the prediction (frames 5-8, 18-21, 27, 30) the frames are weak, not ok
 #   (Tracking.StartDoubt: 0). By default the start is in doubt for its first second: at frame 5 the
 #   keypoints without depth fit the contested step alone 57 times, the prediction 5, and the step is
-#   taken (weak, ATE 0.64 m: frames 1-4 stay where the wrong start put them).
+#   taken (weak, ATE 0.64 m: frames 1-4 stay where the wrong start put them). Since the rays decide
+#   between starts (Tracking.StartByRays) they take the oncoming lanes' 2.26 m a frame over standing
+#   still at frame 1 (55 against 5; they cannot judge the scale), and at frame 6 the true step, on 1.6x
+#   the inliers with the rays not objecting, refutes it (ATE 0.90 m; with the doubt off, standing on
+#   the oncoming lanes' start, 9.2 m and 14 weak frames).
 # - Seed 22, nFeatures 2100: started right, the map slides onto the trucks at the ego speed (steps of
 #   0.94, 1.07, 0.94, 0.59, 0.90, 0.21, 0.30, 0.05 m for 1.0 m, each within a step's reach of the last),
 #   stands from frame 8 and loses 5 frames (ATE 9.64 m). The speed over 0.3 s (Tracking.SpeedWindow)
 #   puts frame 8 back where the speed before puts it: 73 keypoints without depth fit that, 1 the step
 #   (ATE 0.86 m, every frame tracked).
+# - Seed 41, defaults (MAX_WEAK 0): at frame 1 the road's points (37 against 27) chose a start 0.2 m
+#   backwards, the vehicles ahead pulling away, over the true 1.0 m (227 against 432 inliers), the
+#   LiDAR undecided (z 0.60); every later frame followed it (ATE 12.7 m, 34 weak). The keypoints without
+#   depth fit the true start alone 104 times, the backward one 3 (Tracking.StartByRays): ATE 0.020 m,
+#   and the summary lists frame 1 as a start the rays chose.
+# - Seed 23, defaults (MAX_WEAK 0): at frame 1 the starts among all matches are the oncoming lanes' 2.1 m
+#   and a 2.8 m sideways, 13 deg turned alias of the lane lines, which the road's points picked (ATE
+#   0.325 m, every frame ok). The road's keypoints alone start at 1.1 m (Tracking.RoadStart), the local
+#   map re-finds 203 points from there (56 on the road) and the LiDAR sides with it (ATE 0.035 m).
 set(FRAMES 80)
-set(MAX_WEAK ${FRAMES})  # weak frames allowed, as long as none is lost
+if(NOT DEFINED MAX_WEAK)
+  set(MAX_WEAK ${FRAMES})  # weak frames allowed, as long as none is lost
+endif()
 if(NOT DEFINED SEED)
   set(SEED 3)
 endif()

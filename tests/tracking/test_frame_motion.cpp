@@ -222,6 +222,51 @@ TEST_CASE("frame motion: a truck alongside at the camera's speed covers more of 
   }
 }
 
+TEST_CASE("road start: vehicles in both directions hold the subset's matches, the road's keypoints the motion") {
+  const rgbl::PinholeCamera cam = rgbl::test::kitti_camera();
+  std::mt19937 rng(9);
+  // The camera drives 1.0 m forward between a truck alongside at its speed (right) and an oncoming lane
+  // closing at 1.2 m a frame (left); 30 road points ahead are the only static scene. The RANSAC's subset
+  // of ransac_max_points (a stride over all 2030 keypoints) keeps about 5 of them, fewer than a guess needs.
+  Eigen::Isometry3d T_true = Eigen::Isometry3d::Identity();
+  T_true.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);
+  Eigen::Isometry3d T_oncoming = Eigen::Isometry3d::Identity();
+  T_oncoming.translation() = Eigen::Vector3d(0.0, 0.0, -2.2);
+  Scene scene;
+  add_points(scene, rng, 30, {-1.5, 1.65, 6.0}, {1.5, 1.65, 16.0}, T_true);                          // road
+  // the vehicles' bodies end 0.85 m above the road: lower, far points would pass as road within the
+  // depth-relative tolerance of the ground test (ransac_relative_tolerance * z)
+  add_points(scene, rng, 1000, {2.5, -2.6, 3.2}, {2.5, 0.8, 16.0}, Eigen::Isometry3d::Identity());   // truck side
+  add_points(scene, rng, 1000, {-3.5, -2.0, 8.0}, {-3.5, 0.8, 20.0}, T_oncoming);                     // oncoming
+  auto [last, cur] = frames_of(scene, cam, rng);
+  cur.build_grid(cam.width, cam.height);
+  rgbl::TrackerOptions options;
+  rgbl::TrackerOptions guess = options;
+  guess.ransac_min_inliers = options.ransac_guess_min_inliers;
+
+  SECTION("all keypoints: a vehicle's motion") {
+    const auto T = rgbl::estimate_frame_motion(cam, last, cur, guess);
+    REQUIRE(T);
+    CHECK(translation_error(*T, T_true) > 0.8);
+  }
+  SECTION("the road's keypoints alone: the camera's motion, exactly") {
+    const auto T = rgbl::estimate_road_motion(cam, last, cur, options);
+    REQUIRE(T);
+    CHECK(translation_error(*T, T_true) < 1e-3);
+    CHECK(rotation_error_deg(*T, T_true) < 1e-3);
+  }
+  SECTION("fewer road keypoints than a guess needs: no start") {
+    rgbl::TrackerOptions strict = options;
+    strict.ransac_guess_min_inliers = 31;
+    CHECK_FALSE(rgbl::estimate_road_motion(cam, last, cur, strict));
+  }
+  SECTION("no road plane in a frame: no start") {
+    rgbl::TrackerOptions strict = options;
+    strict.ground_min_points = 40;
+    CHECK_FALSE(rgbl::estimate_road_motion(cam, last, cur, strict));
+  }
+}
+
 TEST_CASE("frame motion: ground and moving-object options are validated with their keys") {
   rgbl::TrackerOptions options;
   options.ground_max_tilt_deg = 95.0;

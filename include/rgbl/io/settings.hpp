@@ -31,6 +31,10 @@
 //   refused placed by its scan, default 1),
 //   Tracking.StartDoubt (TrackerOptions::start_doubt_s: seconds after a start without velocity in which
 //   a contested step is taken when the keypoints without depth favour it, default 1, 0 = off),
+//   Tracking.RoadStart (0/1, TrackerOptions::road_start: a start without velocity proposed by the road's
+//   keypoints alone, default 1),
+//   Tracking.StartByRays (0/1, TrackerOptions::start_by_rays: two starts the LiDAR does not decide
+//   decided by the keypoints without depth where they clearly favour one, default 1),
 //   Tracking.SpeedWindow (TrackerOptions::speed_window_s: seconds over which the speed may not change
 //   faster than a vehicle's, the keypoints without depth deciding where it did, default 0.3, 0 = off),
 //   Tracking.RansacPointsNearPrior (TrackerOptions::ransac_max_points_near_prior: keypoints with depth in
@@ -134,6 +138,8 @@ struct Settings {
   std::optional<bool> register_lost;                // Tracking.RegisterLost
   std::optional<bool> register_refused_steps;       // Tracking.RegisterRefusedSteps
   std::optional<double> start_doubt_s;              // Tracking.StartDoubt
+  std::optional<bool> road_start;                   // Tracking.RoadStart
+  std::optional<bool> start_by_rays;                // Tracking.StartByRays
   std::optional<double> speed_window_s;             // Tracking.SpeedWindow
   std::optional<int> ransac_points_near_prior;      // Tracking.RansacPointsNearPrior
   std::optional<int> ransac_points_near_prior_retry;  // Tracking.RansacPointsNearPriorRetry

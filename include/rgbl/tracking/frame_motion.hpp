@@ -97,4 +97,10 @@ std::optional<Eigen::Isometry3d> estimate_frame_motion(const PinholeCamera& came
                                                        std::vector<bool>* moving = nullptr,
                                                        std::optional<RivalMotion>* rival = nullptr);
 
+// T_cur_last from the keypoints on the road (ground_keypoints) of both frames alone: the depth RANSAC
+// without a prior, at ransac_guess_min_inliers. The road does not move; a start for a frame without a
+// velocity where vehicles hold most of the other matches (TrackerOptions::road_start).
+std::optional<Eigen::Isometry3d> estimate_road_motion(const PinholeCamera& camera, const Frame& last, const Frame& frame,
+                                                      const TrackerOptions& options);
+
 }  // namespace rgbl

@@ -76,6 +76,9 @@ struct TrackResult {
   // the speed had changed faster than a vehicle can over TrackerOptions::speed_window_s, and the
   // keypoints without depth took a pose within reach of the speed before (ok unless contested too)
   bool speed_corrected = false;
+  // a start without velocity chosen by the keypoints without depth against the road and the inliers
+  // (TrackerOptions::start_by_rays; its scale unchecked until a contested step)
+  bool start_by_rays = false;
   // the first frame after a gap in the timestamps, its scan registered onto the last frame's
   // (TrackerOptions::register_gaps); gap_registered: the registration was accepted as the prediction
   bool gap = false;

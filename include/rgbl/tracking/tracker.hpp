@@ -24,6 +24,8 @@
 
 namespace rgbl {
 
+struct RayFits;  // tracking/frame_motion.hpp
+
 class TaskPool;
 
 struct TrackerOutcome {
@@ -46,6 +48,9 @@ struct TrackerOutcome {
   // The speed had changed faster than a vehicle can (check_speed over TrackerOptions::speed_window_s)
   // and the keypoints without depth took the frame's pose within reach of the speed before the slide.
   bool speed_corrected = false;
+  // A start without velocity chosen by the keypoints without depth against the road and the inliers
+  // (TrackerOptions::start_by_rays): its scale is unchecked.
+  bool start_by_rays = false;
   // The first frame after a gap in the frames (TrackerOptions::register_gaps): its scan was registered
   // onto the last frame's; gap_registered: accepted, the registration was the prediction.
   bool gap = false;
@@ -112,6 +117,9 @@ class Tracker {
     // weak, but no keyframe for it (the frame adds nothing the map lacks, its pose is the one in doubt)
     bool step_contested = false;
     bool start_refuted = false;  // ...taken, within start_doubt_s of a start (start_)
+    // a start chosen by the keypoints without depth against the road and the inliers (start_by_rays):
+    // its direction stands on the rays, its scale on nothing yet
+    bool start_by_rays = false;
     // a step within reach of the last one but not of the speed over a window (check_speed): placed
     // where the local map searched from the window's prediction ends; that velocity is kept
     std::optional<Eigen::Vector3d> speed_placed;  // the window's velocity, m/s in the world frame
@@ -184,6 +192,9 @@ class Tracker {
   // as the independent units (ScanVote::object_preference).
   int lidar_preference(std::optional<LidarView>& cache, const Frame& frame, const Eigen::Isometry3d& T_a_world,
                        const Eigen::Isometry3d& T_b_world, const char* a, const char* b, bool by_objects) const;
+  // The last frame's keypoints without depth matched into `frame` and tested on two poses of it
+  // (fits_by_rays, the motions from the last frame).
+  RayFits fits_from_last(const Frame& frame, const Eigen::Isometry3d& T_a_world, const Eigen::Isometry3d& T_b_world) const;
   // A pose of the frame beyond a vehicle's reach of the prediction (check_step's translation) whose
   // scan lands better on the last frame's from the prediction; `what` names the pose in the log.
   bool scans_prefer_prediction(std::optional<LidarView>& cache, const Frame& frame,
@@ -223,12 +234,24 @@ class Tracker {
   // start, or (rival) from a second rigid motion among the matches, or (rival, from_lidar) the LiDAR's
   // own start, at its pose without matches.
   struct OtherStart {
+    enum class Source {
+      weak_consensus,  // the depth consensus below ransac_guess_min_inliers
+      second_motion,   // the second rigid motion among the matches
+      road,            // the road's keypoints alone (road_start)
+      lidar,           // the LiDAR's own start (lidar_start_max_speed)
+    };
     Frame frame;
-    bool rival = false;
-    bool from_lidar = false;  // the LiDAR's own start (lidar_start)
+    Source source = Source::weak_consensus;
+    // a rival motion; the weak consensus is the same matches' motion, found again
+    bool rival() const { return source != Source::weak_consensus; }
+    // the road's and the LiDAR's starts are searched in the local map from their pose as proposed,
+    // never refined on the brute-force matches (which hold the vehicles)
+    bool as_proposed() const { return source == Source::road || source == Source::lidar; }
+    const char* name() const;
   };
+
   // Matches the reference keyframe's points by descriptor and optimises the pose. `others` receives the
-  // other starts that converged too (the weak consensus first), and the LiDAR's start as it is.
+  // other starts that converged too (the weak consensus first), and the road's and the LiDAR's starts as they are.
   bool track_reference_keyframe(Frame& frame, std::vector<OtherStart>& others,
                                 std::optional<LidarView>& lidar) const;
   // Unmatches keypoints labelled moving and those whose landmark disagrees with frame.T_cam_world (a
@@ -296,6 +319,7 @@ class Tracker {
   struct Start {
     double time = 0.0;
     std::size_t frame = 0;
+    bool by_rays = false;  // Hypothesis::start_by_rays
   };
   std::optional<Start> start_;
   std::vector<PlacedCentre> recent_;  // consecutive tracked frames since the last start, jump or gap (check_speed)
