@@ -59,12 +59,26 @@ std::pair<rgbl::Frame, rgbl::Frame> frames_of(const Scene& s, const rgbl::Pinhol
   return {make(s.points_last, false), make(s.points_cur, true)};
 }
 
+// A motion without rotation (T_cur_last: a camera driving d metres forward is shift(0, 0, -d)).
+Eigen::Isometry3d shift(double x, double y, double z) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(x, y, z);
+  return T;
+}
+
 double translation_error(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return (a.translation() - b.translation()).norm();
 }
 
 double rotation_error_deg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return Eigen::AngleAxisd(a.linear() * b.linear().transpose()).angle() * 180.0 / 3.14159265358979;
+}
+
+// A motion found, and the true one to a millimetre and a thousandth of a degree.
+void check_exact(const std::optional<Eigen::Isometry3d>& T, const Eigen::Isometry3d& truth) {
+  REQUIRE(T);
+  CHECK(translation_error(*T, truth) < 1e-3);
+  CHECK(rotation_error_deg(*T, truth) < 1e-3);
 }
 
 }  // namespace
@@ -96,15 +110,11 @@ TEST_CASE("frame motion: a van ahead at the camera's speed holds most matches, c
   }
   SECTION("ranked by image coverage, without a prior: the static scene's motion, exactly") {
     const auto T = rgbl::estimate_frame_motion(cam, last, cur, options);
-    REQUIRE(T);
-    CHECK(translation_error(*T, T_true) < 1e-3);
-    CHECK(rotation_error_deg(*T, T_true) < 1e-3);
+    check_exact(T, T_true);
   }
   SECTION("ranked by size, with the prior: the static scene's motion, exactly") {
     const auto T = rgbl::estimate_frame_motion(cam, last, cur, by_size, prior);
-    REQUIRE(T);
-    CHECK(translation_error(*T, T_true) < 1e-3);
-    CHECK(rotation_error_deg(*T, T_true) < 1e-3);
+    check_exact(T, T_true);
   }
   SECTION("a prior far from every consensus: no prediction rather than a jump to the van") {
     Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
@@ -157,9 +167,7 @@ TEST_CASE("frame motion: a truck alongside at the camera's speed covers more of 
   SECTION("ground cells first: the scene's motion, exactly, and the truck's points labelled moving") {
     std::vector<bool> moving;
     const auto T = rgbl::estimate_frame_motion(cam, last, cur, options, std::nullopt, &moving);
-    REQUIRE(T);
-    CHECK(translation_error(*T, T_true) < 1e-3);
-    CHECK(rotation_error_deg(*T, T_true) < 1e-3);
+    check_exact(T, T_true);
     REQUIRE(moving.size() == cur.size());
     int truck = 0, truck_moving = 0, scene_moving = 0;
     for (std::size_t i = 0; i < cur.size(); ++i) {
@@ -228,10 +236,8 @@ TEST_CASE("road start: vehicles in both directions hold the subset's matches, th
   // The camera drives 1.0 m forward between a truck alongside at its speed (right) and an oncoming lane
   // closing at 1.2 m a frame (left); 30 road points ahead are the only static scene. The RANSAC's subset
   // of ransac_max_points (a stride over all 2030 keypoints) keeps about 5 of them, fewer than a guess needs.
-  Eigen::Isometry3d T_true = Eigen::Isometry3d::Identity();
-  T_true.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);
-  Eigen::Isometry3d T_oncoming = Eigen::Isometry3d::Identity();
-  T_oncoming.translation() = Eigen::Vector3d(0.0, 0.0, -2.2);
+  const Eigen::Isometry3d T_true = shift(0.0, 0.0, -1.0);
+  const Eigen::Isometry3d T_oncoming = shift(0.0, 0.0, -2.2);
   Scene scene;
   add_points(scene, rng, 30, {-1.5, 1.65, 6.0}, {1.5, 1.65, 16.0}, T_true);                          // road
   // the vehicles' bodies end 0.85 m above the road: lower, far points would pass as road within the
@@ -251,9 +257,7 @@ TEST_CASE("road start: vehicles in both directions hold the subset's matches, th
   }
   SECTION("the road's keypoints alone: the camera's motion, exactly") {
     const auto T = rgbl::estimate_road_motion(cam, last, cur, options);
-    REQUIRE(T);
-    CHECK(translation_error(*T, T_true) < 1e-3);
-    CHECK(rotation_error_deg(*T, T_true) < 1e-3);
+    check_exact(T, T_true);
   }
   SECTION("fewer road keypoints than a guess needs: no start") {
     rgbl::TrackerOptions strict = options;
@@ -378,9 +382,7 @@ TEST_CASE("frame motion: near a prior with every keypoint with depth, a scene in
   SECTION("near the prior with every keypoint (Tracking.RansacPointsNearPrior: 1000): the scene's motion, exactly") {
     options.ransac_max_points_near_prior = 1000;
     const auto T = rgbl::estimate_frame_motion(cam, last, cur, options, prior);
-    REQUIRE(T);
-    CHECK(translation_error(*T, T_true) < 1e-3);
-    CHECK(rotation_error_deg(*T, T_true) < 1e-3);
+    check_exact(T, T_true);
   }
   SECTION("a subset of 350 alone (the default: no second RANSAC) keeps too few of the scene's matches: no prediction") {
     REQUIRE(options.ransac_max_points_near_prior == 350);
@@ -391,9 +393,7 @@ TEST_CASE("frame motion: near a prior with every keypoint with depth, a scene in
     options.ransac_max_points_near_prior_retry = 1000;
     std::vector<bool> moving;
     const auto T = rgbl::estimate_frame_motion(cam, last, cur, options, prior, &moving);
-    REQUIRE(T);
-    CHECK(translation_error(*T, T_true) < 1e-3);
-    CHECK(rotation_error_deg(*T, T_true) < 1e-3);
+    check_exact(T, T_true);
     CHECK(moving.size() == cur.size());
   }
   SECTION("the second RANSAC is near a prior only: without one the subset's verdict stands") {
@@ -416,10 +416,8 @@ TEST_CASE("rays without depth: the scene beyond the LiDAR tells a driving camera
   // The car drives 1.0 m forward. Without depth: 150 facade points 11-16 m ahead on both sides, 60
   // points on a truck's top alongside that moves with the car (they stay put in the image), 30 points
   // near infinity (they fit any translation). All in view in both frames, as keypoints are.
-  Eigen::Isometry3d T_drive = Eigen::Isometry3d::Identity();
-  T_drive.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);
-  Eigen::Isometry3d T_side = Eigen::Isometry3d::Identity();
-  T_side.translation() = Eigen::Vector3d(1.0, 0.0, 0.0);
+  const Eigen::Isometry3d T_drive = shift(0.0, 0.0, -1.0);
+  const Eigen::Isometry3d T_side = shift(1.0, 0.0, 0.0);
   const Eigen::Isometry3d T_stand = Eigen::Isometry3d::Identity();
   Scene s;
   add_points(s, rng, 75, {-8.0, -2.2, 11.0}, {-6.0, -1.2, 16.0}, T_drive);
