@@ -316,8 +316,8 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
       // motions in view (the scene and a car) are not: each is a consensus of its own.
       const bool apart = !check_step(frame.T_cam_world, other_start.frame.T_cam_world, 0.0, dt, options_).plausible;
       if (apart && !other_start.rival()) h.weak = true;
-      // The LiDAR first, where it is decisive (and the start it picks holds on the local map); else the
-      // keypoints without depth where they are; else the road, then the inliers. The LiDAR only between starts further apart than a step's
+      // The keypoints without depth first, where they are decisive; else the LiDAR, where it is (and the
+      // start it picks holds on the local map); else the road, then the inliers. The LiDAR only between starts further apart than a step's
       // tolerance: its vote judges the motion from the last frame, whose own error is within that.
       // A rival within a step's tolerance of the first start is the same motion found twice.
       // To overrule the images the scans must be decisive with objects as the units: a start locked on
@@ -332,19 +332,21 @@ Tracker::FirstHypothesis Tracker::first_hypothesis(Frame frame, const Prediction
       const bool by_images = other_start.source == OtherStart::Source::road
                                  ? other_road > road && other.inliers > first.local.inliers
                                  : std::pair(other_road, other.inliers) > std::pair(road, first.local.inliers);
-      // Where the scans do not decide, the keypoints without depth do when they clearly favour one start
+      // The keypoints without depth decide first where they clearly favour one start
       // (TrackerOptions::start_by_rays): they tell driving from standing and forward from backward, not
       // the scale. Traffic seed 41, frame 1: the paving and the LiDAR's flat facades took a start 0.2 m
       // backwards (the vehicles ahead pulling away); 104 of them fit the true 1.0 m step alone, 3 that.
+      // Before the LiDAR's objects, which may be trucks at the ego speed: traffic seed 53, frame 1, they
+      // chose standing still over the true 1.0 m decisively (z 3.14).
       int by_rays = 0;
-      if (apart && by_lidar == 0 && other.ok && options_.start_by_rays) {
+      if (apart && other.ok && options_.start_by_rays) {
         const RayFits fits = fits_from_last(frame, frame.T_cam_world, other_start.frame.T_cam_world);
         by_rays = count_preference(fits.a_only, fits.b_only, 3.0);
         logger()->debug("frame {}: of {} matches of the last frame's keypoints without depth, {} fit the first start "
                         "alone, {} the other", frame.index, fits.matches, fits.a_only, fits.b_only);
       }
-      const bool by_evidence = by_rays != 0 ? by_rays > 0 : by_images;
-      const bool better = (apart || !other_start.rival()) && (by_lidar > 0 ? other.ok : by_lidar == 0 && by_evidence);
+      const bool better = (apart || !other_start.rival()) &&
+                          (by_rays != 0 ? by_rays > 0 : (by_lidar > 0 ? other.ok : by_lidar == 0 && by_images));
       // the scans overrule the images: the sensors contradict each other, the frame is never silently ok
       if (by_lidar != 0 && (by_lidar > 0) != by_images) h.weak = true;
       // Where the keypoints without depth overrule those with depth the frame stays ok: on every start

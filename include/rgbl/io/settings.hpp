@@ -33,8 +33,8 @@
 //   a contested step is taken when the keypoints without depth favour it, default 1, 0 = off),
 //   Tracking.RoadStart (0/1, TrackerOptions::road_start: a start without velocity proposed by the road's
 //   keypoints alone, default 1),
-//   Tracking.StartByRays (0/1, TrackerOptions::start_by_rays: two starts the LiDAR does not decide
-//   decided by the keypoints without depth where they clearly favour one, default 1),
+//   Tracking.StartByRays (0/1, TrackerOptions::start_by_rays: two starts decided by the keypoints
+//   without depth where they clearly favour one, before the LiDAR, default 1),
 //   Tracking.SpeedWindow (TrackerOptions::speed_window_s: seconds over which the speed may not change
 //   faster than a vehicle's, the keypoints without depth deciding where it did, default 0.3, 0 = off),
 //   Tracking.RansacPointsNearPrior (TrackerOptions::ransac_max_points_near_prior: keypoints with depth in

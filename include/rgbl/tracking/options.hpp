@@ -206,9 +206,10 @@ struct TrackerOptions {
   // Traffic seed 23, frame 1: the two starts among all matches were the oncoming lanes' 2.1 m and a
   // 2.8 m sideways, 13 deg turned alias of the lane lines; the road's alone 1.1 m (truth 1.0 m).
   bool road_start = true;
-  // Between two starts further apart than a step's tolerance that the LiDAR does not decide, the last
-  // frame's keypoints without depth decide where they fit one clearly more often than the other
-  // (fits_by_rays, a sign test at three sigmas, as for start_doubt_s), before the road and the inliers.
+  // Between two starts further apart than a step's tolerance, the last frame's keypoints without depth
+  // decide where they fit one clearly more often than the other (fits_by_rays, a sign test at three
+  // sigmas, as for start_doubt_s), before the LiDAR's objects (trucks at the ego speed can be most of
+  // them), the road and the inliers.
   // The scene beyond the LiDAR's reach and above its field of view rarely moves with the vehicles that
   // hold a start's depth; the rays tell driving from standing and forward from backward, not the scale.
   // A start they choose against the road and the inliers is reported (TrackResult::start_by_rays) and
