@@ -1109,6 +1109,12 @@ bool Tracker::track_reference_keyframe(Frame& frame, std::vector<OtherStart>& ot
     // consensus are objects moving against the scene (or aliasing), not evidence for the pose.
     drop_moving_matches(f);
   };
+  // the road's and the LiDAR's starts: at their pose without matches (OtherStart::as_proposed)
+  auto add_as_proposed = [&](OtherStart::Source source, const Eigen::Isometry3d& T_cur_last) {
+    OtherStart& other = others.emplace_back(OtherStart{frame, source});
+    clear_matches(other.frame);
+    other.frame.T_cam_world = T_cur_last * last_frame_->T_cam_world;
+  };
   auto add_rival = [&](const Frame& matched, std::optional<RivalMotion>& rival) {
     if (!rival) return;
     OtherStart& other = others.emplace_back(OtherStart{matched, OtherStart::Source::second_motion});
@@ -1141,9 +1147,7 @@ bool Tracker::track_reference_keyframe(Frame& frame, std::vector<OtherStart>& ot
     // step at 25 m), and which pulled the LiDAR's start back onto the standing start (traffic seed 7,
     // frame 1: 1.10 m ahead, optimised to 0.05 m from standing still, the truth 1.0 m). The local map,
     // searched from the LiDAR's pose with its depth gate, refines it.
-    OtherStart& other = others.emplace_back(OtherStart{frame, OtherStart::Source::lidar});
-    clear_matches(other.frame);
-    other.frame.T_cam_world = *T_lidar * last_frame_->T_cam_world;
+    add_as_proposed(OtherStart::Source::lidar, *T_lidar);
   }
   if (last_frame_ && options_.road_start) {
     // The road's own start (TrackerOptions::road_start), searched in the local map as it is, as the
@@ -1157,11 +1161,7 @@ bool Tracker::track_reference_keyframe(Frame& frame, std::vector<OtherStart>& ot
                     T_road ? fmt::format("{:.2f} m from the last frame", T_road->translation().norm())
                            : std::string("nowhere"),
                     watch.elapsed_ms());
-    if (T_road) {
-      OtherStart& other = others.emplace_back(OtherStart{frame, OtherStart::Source::road});
-      clear_matches(other.frame);
-      other.frame.T_cam_world = *T_road * last_frame_->T_cam_world;
-    }
+    if (T_road) add_as_proposed(OtherStart::Source::road, *T_road);
   }
   auto optimise = [&](Frame& f) {
     const int inliers = optimise_pose(f);

@@ -231,7 +231,7 @@ class Tracker {
     return options_.ransac_motion_prior && velocity_steady_ ? velocity_ : std::nullopt;
   }
   // Another start against the reference keyframe: from a depth consensus too weak to be the only
-  // start, or (rival) from a second rigid motion among the matches, or (rival, from_lidar) the LiDAR's
+  // start, or (rival) from a second rigid motion among the matches, or (rival, as proposed) the road's or the LiDAR's
   // own start, at its pose without matches.
   struct OtherStart {
     enum class Source {
