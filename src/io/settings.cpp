@@ -427,6 +427,7 @@ Settings read_settings(const std::filesystem::path& yaml) {
   s.register_refused_steps = flag("Tracking.RegisterRefusedSteps");
   s.road_start = flag("Tracking.RoadStart");
   s.start_by_rays = flag("Tracking.StartByRays");
+  s.confirm_suspect_by_scan = flag("Tracking.ConfirmSuspectByScan");
   s.start_doubt_s = r.number({"Tracking.StartDoubt"});
   if (s.start_doubt_s && !(*s.start_doubt_s >= 0.0 && *s.start_doubt_s <= 60.0))
     r.fail("Tracking.StartDoubt", "seconds from 0 (off) to 60");

@@ -104,6 +104,7 @@ void apply_settings(const Settings& s, Resolved p) {
   if (s.start_doubt_s) p.system.tracker.start_doubt_s = *s.start_doubt_s;
   if (s.road_start) p.system.tracker.road_start = *s.road_start;
   if (s.start_by_rays) p.system.tracker.start_by_rays = *s.start_by_rays;
+  if (s.confirm_suspect_by_scan) p.system.tracker.confirm_suspect_by_scan = *s.confirm_suspect_by_scan;
   if (s.speed_window_s) p.system.tracker.speed_window_s = *s.speed_window_s;
   if (s.ransac_points_near_prior) {
     p.system.tracker.ransac_max_points_near_prior = static_cast<std::size_t>(*s.ransac_points_near_prior);

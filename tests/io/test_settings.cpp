@@ -273,7 +273,7 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
                 "Tracking.CauchyWeights: 0\nTracking.ObjectTest: 1\nTracking.DirectionPrior: 0\n"
                 "Tracking.RegisterRefusedSteps: 0\nTracking.RansacPointsNearPrior: 500\n"
                 "Tracking.RansacPointsNearPriorRetry: 0\nTracking.StartDoubt: 0.5\nTracking.SpeedWindow: 0.4\n"
-                "Tracking.RoadStart: 0\nTracking.StartByRays: 0\n"
+                "Tracking.RoadStart: 0\nTracking.StartByRays: 0\nTracking.ConfirmSuspectByScan: 0\n"
                 "LocalMapping.DepthConsistency: 1\nLocalMapping.Triangulation: 1\n"));
   REQUIRE(s.reference_landmark_ratio);
   CHECK(*s.reference_landmark_ratio == 0.25);
@@ -291,6 +291,7 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK(s.speed_window_s == 0.4);
   CHECK(s.road_start == false);
   CHECK(s.start_by_rays == false);
+  CHECK(s.confirm_suspect_by_scan == false);
   CHECK(s.warnings.empty());
   const auto unset = rgbl::read_settings(tmp.write("unset.yaml", "%YAML:1.0\nCamera.fps: 10\n"));
   CHECK_FALSE(unset.reference_landmark_ratio);
@@ -308,6 +309,7 @@ TEST_CASE("settings: Tracking.ReferenceLandmarkRatio, BoundedDepthError, Registe
   CHECK_FALSE(unset.speed_window_s);
   CHECK_FALSE(unset.road_start);
   CHECK_FALSE(unset.start_by_rays);
+  CHECK_FALSE(unset.confirm_suspect_by_scan);
   CHECK_THAT(error_of(tmp.write("window.yaml", "%YAML:1.0\nTracking.SpeedWindow: 6\n")),
              Contains("'Tracking.SpeedWindow': expected seconds from 0 (off) to 5"));
   CHECK_THAT(error_of(tmp.write("doubt.yaml", "%YAML:1.0\nTracking.StartDoubt: -1\n")),

@@ -203,11 +203,13 @@ TEST_CASE("the settings file's Tracking keys reach the tracker") {
   CHECK(defaults.speed_window_s == 0.3);
   CHECK(defaults.road_start);
   CHECK(defaults.start_by_rays);
+  CHECK(defaults.confirm_suspect_by_scan);
   o.settings = dir.write("t.yaml", "%YAML:1.0\nTracking.ReferenceLandmarkRatio: 0\nTracking.BoundedDepthError: 0\n"
                                    "Tracking.RegisterGaps: 0\nTracking.CauchyWeights: 0\nTracking.ObjectTest: 1\n"
                                    "Tracking.RegisterRefusedSteps: 0\nTracking.RansacPointsNearPrior: 1000\n"
                                    "Tracking.RansacPointsNearPriorRetry: 1000\nTracking.StartDoubt: 0\n"
-                                   "Tracking.SpeedWindow: 0\nTracking.RoadStart: 0\nTracking.StartByRays: 0\n");
+                                   "Tracking.SpeedWindow: 0\nTracking.RoadStart: 0\nTracking.StartByRays: 0\n"
+                                   "Tracking.ConfirmSuspectByScan: 0\n");
   const rgbl::TrackerOptions set = rgbl::Pipeline(o).system_options().tracker;
   CHECK(set.reference_landmark_ratio == 0.0);
   CHECK_FALSE(set.pose.bounded_depth_error);
@@ -221,6 +223,7 @@ TEST_CASE("the settings file's Tracking keys reach the tracker") {
   CHECK(set.speed_window_s == 0.0);
   CHECK_FALSE(set.road_start);
   CHECK_FALSE(set.start_by_rays);
+  CHECK_FALSE(set.confirm_suspect_by_scan);
   CHECK_FALSE(rgbl::Pipeline(o).system_options().mapping.depth_consistency);
   CHECK_FALSE(rgbl::Pipeline(o).system_options().mapping.triangulation);
   o.settings = dir.write("m.yaml", "%YAML:1.0\nLocalMapping.DepthConsistency: 1\nLocalMapping.Triangulation: 1\n");

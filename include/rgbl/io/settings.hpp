@@ -33,6 +33,8 @@
 //   a contested step is taken when the keypoints without depth favour it, default 1, 0 = off),
 //   Tracking.RoadStart (0/1, TrackerOptions::road_start: a start without velocity proposed by the road's
 //   keypoints alone, default 1),
+//   Tracking.ConfirmSuspectByScan (0/1, TrackerOptions::confirm_suspect_by_scan: a suspect motion-model
+//   pose kept when the frame's scan registers onto the last one close to it, default 1),
 //   Tracking.StartByRays (0/1, TrackerOptions::start_by_rays: two starts decided by the keypoints
 //   without depth where they clearly favour one, before the LiDAR, default 1),
 //   Tracking.SpeedWindow (TrackerOptions::speed_window_s: seconds over which the speed may not change
@@ -140,6 +142,7 @@ struct Settings {
   std::optional<double> start_doubt_s;              // Tracking.StartDoubt
   std::optional<bool> road_start;                   // Tracking.RoadStart
   std::optional<bool> start_by_rays;                // Tracking.StartByRays
+  std::optional<bool> confirm_suspect_by_scan;      // Tracking.ConfirmSuspectByScan
   std::optional<double> speed_window_s;             // Tracking.SpeedWindow
   std::optional<int> ransac_points_near_prior;      // Tracking.RansacPointsNearPrior
   std::optional<int> ransac_points_near_prior_retry;  // Tracking.RansacPointsNearPriorRetry

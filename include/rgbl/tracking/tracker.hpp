@@ -158,6 +158,11 @@ class Tracker {
   // checks: the frame's pose when accepted. `what` names the frame's case in the log.
   std::optional<Eigen::Isometry3d> register_onto_last(const Frame& frame, PointCloudView scan,
                                                       const Prediction& prediction, const char* what) const;
+  // TrackerOptions::confirm_suspect_by_scan: right after a tracked frame, a suspect hypothesis whose
+  // frame's scan registers onto the last one (register_onto_last) kept when within a step's reach of
+  // the registration, or moved to where the local map searched from the registration ends there;
+  // false (the frame lost) otherwise.
+  bool confirm_by_scan(Hypothesis& h, PointCloudView scan, const Prediction& prediction, ViewLog& views) const;
   // TrackerOptions::register_refused_steps: a frame whose step was refused placed by its scan.
   void register_refused_step(Hypothesis& h, PointCloudView scan, const Prediction& prediction) const;
   // A pose after a gap further from the registered prediction than the gap tolerance: the local map
