@@ -203,7 +203,8 @@ void Tracker::register_lost(const Frame& frame, PointCloudView scan, Prediction&
 bool Tracker::confirm_by_scan(Hypothesis& h, PointCloudView scan, const Prediction& prediction, ViewLog& views) const {
   // Right after a tracked frame only: the registration measures the motion from the last frame, and
   // after a loss that frame's pose is itself a guess (a jump in the images, 04 frames 19 -> 35: the
-  // frame after the lost one registers onto it within 0.04 m, 21 m from where the car is).
+  // frame after the lost one registers onto it within 0.04 m, 21 m from where the car is; its local
+  // map was too thin to be kept there anyway, so this is a precaution, not a measured fix).
   if (!options_.confirm_suspect_by_scan || prediction.gap || !has_pose(state_) || !velocity_steady_ ||
       last_inliers_ <= 0) {
     return false;
