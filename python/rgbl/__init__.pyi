@@ -335,6 +335,7 @@ class TrackResult:
     start_refuted_since: Optional[int]  # a start given up here: the first frame placed on it (Tracking.StartDoubt)
     speed_corrected: bool  # the speed had slid faster than a car brakes; placed by the speed before it (Tracking.SpeedWindow)
     start_by_rays: bool  # a start chosen by the keypoints without depth against the road and the inliers (Tracking.StartByRays)
+    scan_confirmed: bool  # a suspect pose kept, not lost, where its scan registers (Tracking.ConfirmSuspectByScan)
     gap: bool  # the first frame after a gap in the timestamps, its scan registered onto the last one's
     gap_registered: bool  # ...and the registration was accepted as the prediction
     lost_registered: bool  # a lost frame placed by its scan's registration onto the last frame's

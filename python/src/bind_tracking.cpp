@@ -104,6 +104,7 @@ void bind_tracking(py::module_& m) {
       .def_readonly("speed_corrected", &TrackResult::speed_corrected)
       .def_readonly("start_refuted_since", &TrackResult::start_refuted_since)
       .def_readonly("start_by_rays", &TrackResult::start_by_rays)
+      .def_readonly("scan_confirmed", &TrackResult::scan_confirmed)
       .def_readonly("gap", &TrackResult::gap)
       .def_readonly("gap_registered", &TrackResult::gap_registered)
       .def_readonly("lost_registered", &TrackResult::lost_registered)

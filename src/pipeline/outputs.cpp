@@ -178,6 +178,8 @@ std::string summary_json(const RunResult& run) {
   j["speed_corrected_frames"] = run.frames_where([](const TrackResult& r) { return r.speed_corrected; });
   // starts chosen by the keypoints without depth against the road and the inliers
   j["rays_start_frames"] = run.frames_where([](const TrackResult& r) { return r.start_by_rays; });
+  // suspect poses kept, not lost, on their scan's registration onto the last frame's
+  j["scan_confirmed_frames"] = run.frames_where([](const TrackResult& r) { return r.scan_confirmed; });
   // [frame, the first frame placed on the start it refuted]
   j["refuted_starts"] = Json::array();
   for (const auto& f : run.frames) {
@@ -268,6 +270,11 @@ std::string summary_text(const RunResult& run) {
   if (!corrected.empty()) {
     fmt::format_to(out, "  frame(s) where the speed had slid faster than a vehicle brakes, placed by the speed before it "
                    "(the keypoints without depth agreeing): {}\n", fmt::join(corrected, ", "));
+  }
+  const auto confirmed = run.frames_where([](const TrackResult& r) { return r.scan_confirmed; });
+  if (!confirmed.empty()) {
+    fmt::format_to(out, "  frame(s) the map could not confirm, kept where their scans register (not lost): {}\n",
+                   fmt::join(confirmed, ", "));
   }
   const auto placed = run.frames_where([](const TrackResult& r) { return r.lost_registered; });
   if (!placed.empty()) {

@@ -390,6 +390,7 @@ TrackResult System::track(const SensorFrame& sensor, PreparedFrame prepared) {
   result.start_refuted_since = outcome.start_refuted_since;
   result.speed_corrected = outcome.speed_corrected;
   result.start_by_rays = outcome.start_by_rays;
+  result.scan_confirmed = outcome.scan_confirmed;
   result.gap = outcome.gap;
   result.gap_registered = outcome.gap_registered;
   result.lost_registered = outcome.lost_registered;

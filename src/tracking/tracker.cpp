@@ -217,7 +217,7 @@ bool Tracker::confirm_by_scan(Hypothesis& h, PointCloudView scan, const Predicti
   const auto near = [&](const Frame& f) {
     return check_step(f.T_cam_world, *T_cam_world, last_centre, dt, options_).plausible;
   };
-  if (near(h.frame)) return true;
+  if (near(h.frame)) return h.scan_confirmed = true;
   // The images' pose is off the scan's (a truck passing close pulls the motion model): the local map
   // searched from the registration, taken when it ends there on an ok frame's support.
   Search search = search_from(h.frame, *T_cam_world, h.reference, h.relocalisation_frame);
@@ -228,7 +228,7 @@ bool Tracker::confirm_by_scan(Hypothesis& h, PointCloudView scan, const Predicti
   if (!take) return false;
   h.reference = search.local.reference;
   settle(h, std::move(search), true, *T_cam_world, views);
-  return true;
+  return h.scan_confirmed = true;
 }
 
 void Tracker::register_refused_step(Hypothesis& h, PointCloudView scan, const Prediction& prediction) const {
@@ -759,6 +759,7 @@ void Tracker::commit(Hypothesis& h, const Prediction& prediction, const FirstHyp
   if (h.start_refuted) outcome.start_refuted_since = start_->frame;
   outcome.speed_corrected = h.speed_placed.has_value();
   outcome.start_by_rays = h.start_by_rays;
+  outcome.scan_confirmed = h.scan_confirmed;
   outcome.gap = prediction.gap;
   outcome.gap_registered = prediction.registered;
   int inliers = h.inliers;

@@ -79,6 +79,9 @@ struct TrackResult {
   // a start without velocity chosen by the keypoints without depth against the road and the inliers
   // (TrackerOptions::start_by_rays; its scale unchecked until a contested step)
   bool start_by_rays = false;
+  // a suspect motion-model pose kept, not lost, because the frame's scan registered onto the last one
+  // near it (TrackerOptions::confirm_suspect_by_scan)
+  bool scan_confirmed = false;
   // the first frame after a gap in the timestamps, its scan registered onto the last frame's
   // (TrackerOptions::register_gaps); gap_registered: the registration was accepted as the prediction
   bool gap = false;

@@ -51,6 +51,9 @@ struct TrackerOutcome {
   // A start without velocity chosen by the keypoints without depth against the road and the inliers
   // (TrackerOptions::start_by_rays): its scale is unchecked.
   bool start_by_rays = false;
+  // A suspect motion-model pose kept because the frame's scan registered onto the last one near it
+  // (TrackerOptions::confirm_suspect_by_scan), where it would have been lost.
+  bool scan_confirmed = false;
   // The first frame after a gap in the frames (TrackerOptions::register_gaps): its scan was registered
   // onto the last frame's; gap_registered: accepted, the registration was the prediction.
   bool gap = false;
@@ -120,6 +123,7 @@ class Tracker {
     // a start chosen by the keypoints without depth against the road and the inliers (start_by_rays):
     // its direction stands on the rays, its scale on nothing yet
     bool start_by_rays = false;
+    bool scan_confirmed = false;  // a suspect pose kept on the scan's registration (confirm_by_scan)
     // a step within reach of the last one but not of the speed over a window (check_speed): placed
     // where the local map searched from the window's prediction ends; that velocity is kept
     std::optional<Eigen::Vector3d> speed_placed;  // the window's velocity, m/s in the world frame
