@@ -126,7 +126,10 @@ TrackerOutcome Tracker::track_frame(Frame& frame, bool mapping_idle, std::size_t
     if (first.suspect) {
       logger()->debug("frame {}: motion model suspect ({} inliers, last frame {}; local map {}/{}): {}",
                       h.frame.index, first.motion_inliers, last_inliers_, first.local.inliers, first.local.visible,
-                      h.relocalised ? "relocalised" : (h.ok ? "confirmed by its scan" : "lost"));
+                      h.relocalised    ? "relocalised"
+                      : h.scan_confirmed ? "confirmed by its scan"
+                      : h.ok             ? "confirmed"
+                                         : "lost");
     }
   }
   // A frame the images cannot place after a registered gap is lost all the same, at the registered
