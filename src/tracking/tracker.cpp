@@ -121,7 +121,8 @@ TrackerOutcome Tracker::track_frame(Frame& frame, bool mapping_idle, std::size_t
     if (relocalised.ok && relocalised.inliers > h.inliers && !scans_refuse_relocalisation(relocalised, prediction)) {
       h = std::move(relocalised);
     } else if (!relocalised.ok && first.suspect) {
-      h.ok = h.ok && confirm_by_scan(h, scan, prediction, views);
+      h.scan_confirmed = h.ok && confirm_by_scan(h, scan, prediction, views);
+      h.ok = h.scan_confirmed;
     }
     if (first.suspect) {
       logger()->debug("frame {}: motion model suspect ({} inliers, last frame {}; local map {}/{}): {}",
@@ -203,7 +204,7 @@ void Tracker::register_lost(const Frame& frame, PointCloudView scan, Prediction&
   }
 }
 
-bool Tracker::confirm_by_scan(Hypothesis& h, PointCloudView scan, const Prediction& prediction, ViewLog& views) const {
+bool Tracker::confirm_by_scan(Hypothesis& h, PointCloudView scan, Prediction& prediction, ViewLog& views) const {
   // Right after a tracked frame only: the registration measures the motion from the last frame, and
   // after a loss that frame's pose is itself a guess (a jump in the images, 04 frames 19 -> 35: the
   // frame after the lost one registers onto it within 0.04 m, 21 m from where the car is; its local
@@ -220,7 +221,7 @@ bool Tracker::confirm_by_scan(Hypothesis& h, PointCloudView scan, const Predicti
   const auto near = [&](const Frame& f) {
     return check_step(f.T_cam_world, *T_cam_world, last_centre, dt, options_).plausible;
   };
-  if (near(h.frame)) return h.scan_confirmed = true;
+  if (near(h.frame)) return true;
   // The images' pose is off the scan's (a truck passing close pulls the motion model): the local map
   // searched from the registration, taken when it ends there on an ok frame's support.
   Search search = search_from(h.frame, *T_cam_world, h.reference, h.relocalisation_frame);
@@ -231,10 +232,10 @@ bool Tracker::confirm_by_scan(Hypothesis& h, PointCloudView scan, const Predicti
   if (!take) return false;
   h.reference = search.local.reference;
   settle(h, std::move(search), true, *T_cam_world, views);
-  return h.scan_confirmed = true;
+  return true;
 }
 
-void Tracker::register_refused_step(Hypothesis& h, PointCloudView scan, const Prediction& prediction) const {
+void Tracker::register_refused_step(Hypothesis& h, PointCloudView scan, Prediction& prediction) const {
   if (!options_.register_refused_steps || prediction.gap) return;
   if (const auto T_cam_world = register_onto_last(h.frame, scan, prediction, "its step refused")) {
     h.frame.T_cam_world = *T_cam_world;
@@ -243,7 +244,9 @@ void Tracker::register_refused_step(Hypothesis& h, PointCloudView scan, const Pr
 }
 
 std::optional<Eigen::Isometry3d> Tracker::register_onto_last(const Frame& frame, PointCloudView scan,
-                                                             const Prediction& prediction, const char* what) const {
+                                                             Prediction& prediction, const char* what) const {
+  if (prediction.onto_last_tried) return prediction.onto_last;
+  prediction.onto_last_tried = true;
   if (!T_cam_lidar_ || !last_frame_ || last_scan_.empty() || scan.empty()) return std::nullopt;
   const double dt = frame.timestamp - last_frame_->timestamp;
   if (!(dt > 0.0 && dt <= options_.max_gap_s)) return std::nullopt;
@@ -258,7 +261,8 @@ std::optional<Eigen::Isometry3d> Tracker::register_onto_last(const Frame& frame,
                   g->registration.runner_up_agreement, g->registration.agreement, g->registration.min_probe_loss,
                   g->accepted ? "its pose" : "not taken", watch.elapsed_ms());
   if (!g->accepted) return std::nullopt;
-  return g->T_reference_query.inverse() * prediction.T_last_world;  // T_last_cur's inverse
+  prediction.onto_last = g->T_reference_query.inverse() * prediction.T_last_world;  // T_last_cur's inverse
+  return prediction.onto_last;
 }
 
 const char* Tracker::OtherStart::name() const {
@@ -578,7 +582,7 @@ Tracker::Hypothesis Tracker::step_hypothesis(Hypothesis h, const Prediction& pre
     // the images place the frame twice, apart. Where the scans clearly prefer the prediction to the
     // nearer of the two, the one further off is not taken on the images' word either (traffic seed
     // 57, frame 19, a truck and a bus filling the view: the step 0.77 m back on 144 inliers, 217
-    // returns against 249; the search's pose 0.42 m back on 174, 123 against 179; truth 0.56 m ahead).
+    // returns against 249; the search's pose 0.42 m back on 174, 123 against 179; truth ~0.55 m ahead).
     if (plausible_alternative || !from_prediction.ok || candidate_step.translation_m >= step.translation_m) {
       return false;
     }

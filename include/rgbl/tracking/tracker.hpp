@@ -148,6 +148,10 @@ class Tracker {
     Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();   // over the time elapsed since
     bool gap = false;         // the first frame after a gap, its scan registered (register_gap)
     bool registered = false;  // ...and T_cam_world is that registration
+    // register_onto_last's result from this guess, once asked: a suspect frame's registration is the
+    // one its loss or its refused step would ask again
+    bool onto_last_tried = false;
+    std::optional<Eigen::Isometry3d> onto_last;
   };
 
   TrackerOutcome track_frame(Frame& frame, bool mapping_idle, std::size_t keyframes_queued, PointCloudView scan);
@@ -159,16 +163,17 @@ class Tracker {
   // time since the last frame (TrackerOptions::register_lost).
   void register_lost(const Frame& frame, PointCloudView scan, Prediction& prediction) const;
   // The frame's scan registered onto the last frame's from the prediction, with gap_registration's
-  // checks: the frame's pose when accepted. `what` names the frame's case in the log.
+  // checks: the frame's pose when accepted. `what` names the frame's case in the log. Registered once
+  // per prediction (Prediction::onto_last), whichever case asks first.
   std::optional<Eigen::Isometry3d> register_onto_last(const Frame& frame, PointCloudView scan,
-                                                      const Prediction& prediction, const char* what) const;
+                                                      Prediction& prediction, const char* what) const;
   // TrackerOptions::confirm_suspect_by_scan: right after a tracked frame, a suspect hypothesis whose
   // frame's scan registers onto the last one (register_onto_last) kept when within a step's reach of
   // the registration, or moved to where the local map searched from the registration ends there;
   // false (the frame lost) otherwise.
-  bool confirm_by_scan(Hypothesis& h, PointCloudView scan, const Prediction& prediction, ViewLog& views) const;
+  bool confirm_by_scan(Hypothesis& h, PointCloudView scan, Prediction& prediction, ViewLog& views) const;
   // TrackerOptions::register_refused_steps: a frame whose step was refused placed by its scan.
-  void register_refused_step(Hypothesis& h, PointCloudView scan, const Prediction& prediction) const;
+  void register_refused_step(Hypothesis& h, PointCloudView scan, Prediction& prediction) const;
   // A pose after a gap further from the registered prediction than the gap tolerance: the local map
   // searched from the registration instead, else the frame weak at the registered pose.
   Hypothesis gap_hypothesis(Hypothesis h, const Prediction& prediction, ViewLog& views) const;
